@@ -1,0 +1,38 @@
+"""Errors a user can cause and fix. The CLI prints their message, never a traceback."""
+
+from __future__ import annotations
+
+
+class ShellsimError(Exception):
+    """Base of every error that is the user's to fix (bad deck, bad mesh, bad output path)."""
+
+
+class DeckError(ShellsimError):
+    """A deck that cannot be read or does not validate.
+
+    Parameters
+    ----------
+    file : str
+        Path of the deck as the user gave it.
+    problems : list[str]
+        One line per problem, each naming the key path, the value given and what was expected.
+    """
+
+    def __init__(self, file: str, problems: list[str]):
+        self.file = file
+        self.problems = problems
+        count = f"{len(problems)} problem{'s' if len(problems) != 1 else ''}"
+        lines = "\n".join(f"  - {p}" for p in problems)
+        super().__init__(f"{file}: {count}:\n{lines}")
+
+
+class MeshError(ShellsimError):
+    """A mesh that cannot be built, imported or used (wrong element type, folded element...)."""
+
+
+class OutputError(ShellsimError):
+    """Results that cannot be written (unwritable directory, disk full)."""
+
+
+class NotYetAvailable(ShellsimError):
+    """A command whose work is planned but not built yet."""

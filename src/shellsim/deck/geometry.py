@@ -1,0 +1,205 @@
+"""The ``[geometry]`` table: one model per gmsh builder, chosen by ``builder``.
+
+Each model declares what its builder produces, so a deck can be checked against it
+without meshing: ``DIVISIONS`` (the names of the ``[mesh] divisions`` it reads, with their
+defaults) and :meth:`sets` (named sets and their kind: ``surface``, ``edge`` or ``point``).
+The builders in :mod:`shellsim.geometry.builders` create exactly these sets (tested).
+Every mesh also has the surface set ``all``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal, Union
+
+from pydantic import Field, model_validator
+
+from .types import Positive, Section
+
+SetKinds = dict[str, str]
+
+
+class Rectangle(Section):
+    """Flat plate or strip in the plane z = 0, corner at the origin, x along ``length``.
+
+    Sets: edges ``x0``, ``x1`` (x = 0, x = length), ``y0``, ``y1``; corner points
+    ``x0y0``, ``x1y0``, ``x1y1``, ``x0y1``. Divisions ``length`` x ``width``; irregular
+    element boundaries along y = 0 and y = width come from ``[mesh] boundaries_y0/_y1``.
+    """
+
+    builder: Literal["rectangle"]
+    length: Positive
+    width: Positive
+    DIVISIONS: ClassVar[dict[str, int]] = {"length": 2, "width": 2}
+
+    def sets(self) -> SetKinds:
+        return _edges("x0", "x1", "y0", "y1") | _points("x0y0", "x1y0", "x1y1", "x0y1")
+
+
+class CylindricalPanel(Section):
+    """Open cylindrical panel (Scordelis-Lo roof), axis along y: a mid-surface point at
+    angle phi from the crown and axial position y is (R sin phi, y, R cos phi),
+    phi in [0, angle_deg], y in [0, length].
+
+    Sets: edges ``phi0`` (crown line), ``phi1`` (free edge), ``y0``, ``y1`` (curved ends);
+    points ``phi0_y0``, ``phi1_y0``, ``phi1_y1``, ``phi0_y1``. Divisions ``around`` x ``along``.
+    """
+
+    builder: Literal["cylindrical_panel"]
+    radius: Positive
+    length: Positive
+    angle_deg: Annotated[float, Field(strict=True, gt=0, lt=180)]
+    DIVISIONS: ClassVar[dict[str, int]] = {"around": 4, "along": 4}
+
+    def sets(self) -> SetKinds:
+        return _edges("phi0", "phi1", "y0", "y1") | _points(
+            "phi0_y0", "phi1_y0", "phi1_y1", "phi0_y1"
+        )
+
+
+class TwistedStrip(Section):
+    """Strip pre-twisted about its straight axis x: the point at axial position x and width
+    coordinate w in [-width/2, width/2] is (x, w cos a, w sin a), a = twist (x / length).
+
+    Sets: edges ``root``, ``tip``, ``side0``, ``side1``; point ``tip_centre``.
+    Divisions ``length`` x ``width`` (``width`` must be even so the tip centre is a node).
+    """
+
+    builder: Literal["twisted_strip"]
+    length: Positive
+    width: Positive
+    twist_deg: Annotated[float, Field(strict=True, ge=-180, le=180)] = 90.0
+    DIVISIONS: ClassVar[dict[str, int]] = {"length": 4, "width": 2}
+
+    def sets(self) -> SetKinds:
+        return _edges("root", "tip", "side0", "side1") | _points("tip_centre")
+
+
+class AnnularSector(Section):
+    """Flat annular sector in z = 0 centred at the origin, theta in [0, angle_deg]
+    (the cross-section of a thick-walled pipe, loaded in its plane).
+
+    Sets: edges ``inner``, ``outer``, ``theta0`` (on the x axis), ``theta1``; points
+    ``inner_theta0``, ``outer_theta0``, ``outer_theta1``, ``inner_theta1``.
+    Divisions ``around`` x ``radial``.
+    """
+
+    builder: Literal["annular_sector"]
+    inner_radius: Positive
+    outer_radius: Positive
+    angle_deg: Annotated[float, Field(strict=True, gt=0, lt=180)] = 90.0
+    DIVISIONS: ClassVar[dict[str, int]] = {"around": 2, "radial": 2}
+
+    @model_validator(mode="after")
+    def _radii(self) -> "AnnularSector":
+        if self.outer_radius <= self.inner_radius:
+            raise ValueError(
+                f"outer_radius ({self.outer_radius}) must exceed inner_radius ({self.inner_radius})"
+            )
+        return self
+
+    def sets(self) -> SetKinds:
+        return _edges("inner", "outer", "theta0", "theta1") | _points(
+            "inner_theta0", "outer_theta0", "outer_theta1", "inner_theta1"
+        )
+
+
+class PlateWithHole(Section):
+    """Quarter of a square plate 2W x 2W with a central circular hole, in z = 0:
+    0 <= x, y <= half_width outside the hole. Split along the 45-degree line into two
+    patches, each ``around`` x ``radial`` elements.
+
+    Sets: edges ``hole``, ``x0`` (x = 0), ``y0`` (y = 0), ``x1`` (x = W), ``y1`` (y = W);
+    points ``A`` = (a, 0), ``B`` = (0, a), ``C`` = (W, W).
+    """
+
+    builder: Literal["plate_with_hole"]
+    half_width: Positive
+    hole_radius: Positive
+    DIVISIONS: ClassVar[dict[str, int]] = {"around": 1, "radial": 1}
+
+    @model_validator(mode="after")
+    def _hole_fits(self) -> "PlateWithHole":
+        if self.hole_radius >= self.half_width:
+            raise ValueError(
+                f"hole_radius ({self.hole_radius}) must be smaller than half_width ({self.half_width})"
+            )
+        return self
+
+    def sets(self) -> SetKinds:
+        return _edges("hole", "x0", "y0", "x1", "y1") | _points("A", "B", "C")
+
+
+class Tube(Section):
+    """Quarter of a tube (x, y >= 0) with its axis along z, from the mid-length symmetry
+    plane z = 0 to z = length, optionally closed there by a hemispherical cap.
+    The shell mid-surface radius is ``inner_radius + thickness / 2`` ([section] thickness).
+
+    Sets: surfaces ``wall`` (and ``cap``); edges ``sym_x`` (x = 0), ``sym_y`` (y = 0),
+    ``z0`` (z = 0), and ``end`` (z = length) for an open tube; points ``z0_x`` and ``z0_y``
+    (on the x and y axes at z = 0), and ``pole`` with a cap.
+    Divisions ``around`` (over the quarter; even) x ``axial``.
+    """
+
+    builder: Literal["tube"]
+    inner_radius: Positive
+    length: Positive
+    cap: Literal["none", "hemisphere"] = "none"
+    DIVISIONS: ClassVar[dict[str, int]] = {"around": 2, "axial": 8}
+
+    def sets(self) -> SetKinds:
+        sets = {"wall": "surface"} | _edges("sym_x", "sym_y", "z0") | _points("z0_x", "z0_y")
+        if self.cap == "hemisphere":
+            return sets | {"cap": "surface"} | _points("pole")
+        return sets | _edges("end")
+
+
+class Hemisphere(Section):
+    """Quarter of a hemisphere (x, y, z >= 0) centred at the origin, pole on +z, built from
+    three curved patches of ``patch`` x ``patch`` elements.
+
+    Sets: edges ``equator``, ``sym_x`` (x = 0), ``sym_y`` (y = 0); points ``pole``,
+    ``equator_x``, ``equator_y``.
+    """
+
+    builder: Literal["hemisphere"]
+    radius: Positive
+    DIVISIONS: ClassVar[dict[str, int]] = {"patch": 2}
+
+    def sets(self) -> SetKinds:
+        return _edges("equator", "sym_x", "sym_y") | _points("pole", "equator_x", "equator_y")
+
+
+class MeshFile(Section):
+    """A mesh of 9-node quadrilaterals read with meshio (any format it reads), ``path``
+    relative to the deck. Named sets come from the file's cell sets (gmsh physical groups)
+    or from point-data arrays named ``set_<name>``."""
+
+    builder: Literal["file"]
+    path: Annotated[str, Field(strict=True, min_length=1)]
+    DIVISIONS: ClassVar[dict[str, int]] = {}
+
+
+Geometry = Annotated[
+    Union[
+        Rectangle, CylindricalPanel, TwistedStrip, AnnularSector, PlateWithHole, Tube,
+        Hemisphere, MeshFile,
+    ],
+    Field(discriminator="builder"),
+]
+
+#: builder name -> model class, for defaults and messages.
+BUILDERS = {
+    cls.model_fields["builder"].annotation.__args__[0]: cls
+    for cls in (
+        Rectangle, CylindricalPanel, TwistedStrip, AnnularSector, PlateWithHole, Tube,
+        Hemisphere, MeshFile,
+    )
+}
+
+
+def _edges(*names: str) -> SetKinds:
+    return {n: "edge" for n in names}
+
+
+def _points(*names: str) -> SetKinds:
+    return {n: "point" for n in names}

@@ -1,0 +1,82 @@
+"""The deck reference (docs/decks.md), written from the deck models themselves so it
+cannot drift from what the program accepts. Regenerate with
+``python -m shellsim.deck.reference_doc > docs/decks.md``."""
+
+from __future__ import annotations
+
+import inspect
+
+from pydantic import BaseModel
+from pydantic_core import PydanticUndefined
+
+from . import schema
+from .curves import Curve
+from .geometry import BUILDERS
+from .material import MATERIALS, CylindricalAxes, FixedAxes
+
+INTRO = """# Deck reference
+
+A deck is one TOML file describing one scene. Tables may come in any order; unknown keys
+are errors; a deck states only what its scene needs and everything else takes the default
+shown. Units are whatever the deck uses consistently: `[meta] units` is only a label.
+
+This page is generated from the deck models (`python -m shellsim.deck.reference_doc`).
+"""
+
+
+def _tag(cls: type[BaseModel]) -> str:
+    """The discriminating value of a union member (builder, model, type, kind)."""
+    first = next(iter(cls.model_fields.values()))
+    return first.annotation.__args__[0]
+
+
+def _default(field) -> str:
+    if field.default is PydanticUndefined and field.default_factory is None:
+        return "required"
+    value = field.default_factory() if field.default_factory is not None else field.default
+    return f"`{value!r}`"
+
+
+def _table(cls: type[BaseModel], heading: str, skip_tag: bool = False) -> list[str]:
+    rows = [f"{heading}", "", inspect.cleandoc(cls.__doc__ or ""), "", "| key | default |", "|---|---|"]
+    names = list(cls.model_fields)[1 if skip_tag else 0:]
+    rows += [f"| `{name}` | {_default(cls.model_fields[name])} |" for name in names]
+    return rows + [""]
+
+
+def deck_reference() -> str:
+    """The whole reference as Markdown."""
+    lines = [INTRO]
+    lines += _table(schema.Meta, "## [meta]")
+    lines += ["## [geometry]", "", "Chosen by `builder`; every mesh also has the surface set `all`.", ""]
+    for cls in BUILDERS.values():
+        lines += _table(cls, f'### builder = "{_tag(cls)}"', skip_tag=True)
+        if cls.DIVISIONS:
+            lines += ["`[mesh] divisions` and their defaults: "
+                      + ", ".join(f"`{k} = {v}`" for k, v in cls.DIVISIONS.items()), ""]
+    lines += _table(schema.MeshOptions, "## [mesh]")
+    lines += ["## [material]", "", "Chosen by `model`.", ""]
+    for cls in MATERIALS.values():
+        lines += _table(cls, f'### model = "{_tag(cls)}"', skip_tag=True)
+    lines += ["Material axes (`axes`), chosen by `kind`:", ""]
+    for cls in (CylindricalAxes, FixedAxes):
+        lines += _table(cls, f'#### kind = "{_tag(cls)}"', skip_tag=True)
+    lines += _table(schema.ShellSection, "## [section]")
+    lines += ["## [[boundary]]", "", "Chosen by `type`.", ""]
+    for cls in (schema.Clamped, schema.Fixed, schema.Symmetry, schema.Prescribed):
+        lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
+    lines += ["## [[load]]", "", "Chosen by `type`; a load is `value * curve(t)`, constant without a curve.", ""]
+    for cls in (schema.Pressure, schema.EdgeForce, schema.EdgePressure, schema.EdgeMoment,
+                schema.PointForce, schema.PointMoment, schema.BodyForce):
+        lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
+    lines += _table(Curve, "## [curves.NAME]")
+    lines += _table(schema.Solver, "## [solver]")
+    lines += _table(schema.Output, "## [output]")
+    lines += _table(schema.Probe, "## [[output.probe]]")
+    lines += _table(schema.Render, "## [[output.render]]")
+    lines += _table(schema.Reference, "## [reference] (one) or [[reference]] (several)")
+    return "\n".join(lines).rstrip() + "\n"
+
+
+if __name__ == "__main__":  # pragma: no cover
+    print(deck_reference(), end="")

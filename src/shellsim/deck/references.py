@@ -1,0 +1,87 @@
+"""Names that tie the deck's tables together: sets (from the geometry), curves, probes.
+
+Checked after the tables themselves validate, against the set names the geometry will
+produce, so a misspelt name is caught before any meshing or computing.
+"""
+
+from __future__ import annotations
+
+import difflib
+
+from .schema import Deck
+
+#: Which set kinds each load type acts on.
+LOAD_SET_KINDS = {
+    "pressure": ("surface",),
+    "body_force": ("surface",),
+    "edge_force": ("edge",),
+    "edge_pressure": ("edge",),
+    "edge_moment": ("edge",),
+    "point_force": ("point", "edge", "surface"),
+    "point_moment": ("point", "edge", "surface"),
+}
+
+
+def did_you_mean(word: str, choices: list[str] | tuple[str, ...]) -> str:
+    """'; did you mean 'x'?' when a choice is close to ``word``, else ''."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f"; did you mean '{close[0]}'?" if close else ""
+
+
+def all_sets(deck: Deck, geometry_sets: dict[str, str]) -> dict[str, str]:
+    """Every named set of the scene with its kind: the geometry's, ``all``, and the deck's
+    own ``[mesh] points``."""
+    return geometry_sets | {"all": "surface"} | {name: "point" for name in deck.mesh.points}
+
+
+def check_references(deck: Deck, geometry_sets: dict[str, str]) -> list[str]:
+    """Problems with names in ``deck``, one message per problem (empty when all resolve).
+
+    Parameters
+    ----------
+    deck : a validated deck.
+    geometry_sets : set name -> kind ('surface', 'edge' or 'point') the geometry provides.
+    """
+    sets = all_sets(deck, geometry_sets)
+    problems: list[str] = []
+
+    def need_set(path: str, name: str, kinds: tuple[str, ...] = ("surface", "edge", "point")) -> None:
+        if name not in sets:
+            listing = ", ".join(sorted(sets))
+            problems.append(
+                f"{path}: unknown set '{name}'{did_you_mean(name, sorted(sets))} "
+                f"(sets of this geometry: {listing})"
+            )
+        elif sets[name] not in kinds:
+            problems.append(
+                f"{path}: set '{name}' is a {sets[name]} set; expected a "
+                f"{' or '.join(kinds)} set here"
+            )
+
+    def need_curve(path: str, name: str | None) -> None:
+        if name is not None and name not in deck.curves:
+            known = ", ".join(sorted(deck.curves)) or "none defined"
+            problems.append(
+                f"{path}: unknown curve '{name}'{did_you_mean(name, sorted(deck.curves))} "
+                f"(curves: {known})"
+            )
+
+    for name in deck.mesh.points:
+        if name in geometry_sets:
+            problems.append(f"mesh.points.{name}: the geometry already has a set named '{name}'")
+    for i, bc in enumerate(deck.boundary):
+        need_set(f"boundary[{i}].set", bc.set)
+        need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))
+    for i, load in enumerate(deck.load):
+        need_set(f"load[{i}].set", load.set, LOAD_SET_KINDS[load.type])
+        need_curve(f"load[{i}].curve", load.curve)
+    for i, probe in enumerate(deck.output.probe):
+        need_set(f"output.probe[{i}].set", probe.set)
+    probes = [p.name for p in deck.output.probe]
+    for i, ref in enumerate(deck.reference):
+        if ref.probe not in probes:
+            problems.append(
+                f"reference[{i}].probe: unknown probe '{ref.probe}'{did_you_mean(ref.probe, probes)} "
+                f"(probes: {', '.join(probes) or 'none; add [[output.probe]]'})"
+            )
+    return problems

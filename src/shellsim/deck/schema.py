@@ -1,0 +1,411 @@
+"""The deck: one TOML file describing one scene. Every table is validated here; references
+between tables (set, curve and probe names) are checked in :mod:`shellsim.deck.references`.
+
+A deck states only what its scene needs: everything else has a default, and the resolved
+deck (defaults filled) is what the program runs.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import BeforeValidator, Field, field_validator, model_validator
+
+from .curves import Curve
+from .geometry import BUILDERS, Geometry
+from .material import MATERIALS, Material
+from .types import Count, Name, NonNegative, Positive, Real, Section, Vec3
+
+Axis = Literal["x", "y", "z"]
+
+
+class Meta(Section):
+    """What the scene is. ``units`` is a label for printouts; nothing is converted."""
+
+    title: Annotated[str, Field(strict=True, min_length=1)]
+    units: Literal["SI", "mm-t-s", "mm-kg-ms", "in-lbf-s", "consistent"] = "SI"
+    description: str = ""
+    source: str = ""
+
+
+class MeshOptions(Section):
+    """``[mesh]``: element divisions per builder direction (see the builder), optional
+    irregular element boundaries of a rectangle (fractions of its length along y = 0 and
+    y = width, 0 first and 1 last), and extra named points snapped to the nearest node."""
+
+    divisions: dict[str, Count] = {}
+    boundaries_y0: list[Real] | None = None
+    boundaries_y1: list[Real] | None = None
+    points: dict[Name, Vec3] = {}
+
+    @field_validator("boundaries_y0", "boundaries_y1")
+    @classmethod
+    def _fractions(cls, b: list[float] | None) -> list[float] | None:
+        if b is None:
+            return b
+        if len(b) < 2 or b[0] != 0.0 or b[-1] != 1.0:
+            raise ValueError(f"must run from 0 to 1 (fractions of the length), got {b}")
+        if any(b1 <= b0 for b0, b1 in zip(b, b[1:])):
+            raise ValueError(f"must be strictly increasing, got {b}")
+        return b
+
+
+class ShellSection(Section):
+    """``[section]``: the shell through its thickness.
+
+    ``technique`` selects the large-strain constitutive treatment of thesis 3.10 (1, 2 or
+    3); leave it out for small strain (linear elastic only). ``plane_strain`` replaces the
+    zero-normal-stress lamina law by plane strain through the thickness direction (an
+    in-plane model of a long body, thesis Test 7). ``thickness_update`` is the fibre-length
+    update of thesis 3.11 (on by default with a large-strain technique).
+    """
+
+    thickness: Positive
+    points_through_thickness: Literal[1, 2, 3] = 2
+    technique: Literal[1, 2, 3] | None = None
+    formulation: Literal["total", "incremental"] = "total"
+    plane_strain: bool = False
+    thickness_update: bool | None = None
+
+    @model_validator(mode="after")
+    def _thickness_update_needs_large_strain(self) -> "ShellSection":
+        if self.thickness_update and self.technique is None:
+            raise ValueError("thickness_update needs a large-strain technique (technique = 1, 2 or 3)")
+        return self
+
+
+class Clamped(Section):
+    """All translations and the director fixed."""
+
+    type: Literal["clamped"]
+    set: Name
+
+
+class Fixed(Section):
+    """Chosen global translations fixed; the director ``free``, ``fixed``, or kept in the
+    plane with normal ``director_plane_normal`` (a hard simple support along an edge keeps
+    the director in the plane normal to the edge)."""
+
+    type: Literal["fixed"]
+    set: Name
+    translations: list[Axis] = []
+    director: Literal["free", "fixed"] = "free"
+    director_plane_normal: Vec3 | None = None
+
+    @model_validator(mode="after")
+    def _fixes_something(self) -> "Fixed":
+        if not self.translations and self.director == "free" and self.director_plane_normal is None:
+            raise ValueError("fixes nothing: give translations, director = 'fixed' or director_plane_normal")
+        if self.director == "fixed" and self.director_plane_normal is not None:
+            raise ValueError("director = 'fixed' already fixes the director; drop director_plane_normal")
+        return self
+
+
+class Symmetry(Section):
+    """Symmetry plane with unit normal ``normal``: u . n = 0 and the director stays in
+    the plane."""
+
+    type: Literal["symmetry"]
+    set: Name
+    normal: Vec3
+
+    @field_validator("normal")
+    @classmethod
+    def _unit(cls, n: tuple[float, float, float]) -> tuple[float, float, float]:
+        length = sum(c * c for c in n) ** 0.5
+        if length == 0.0:
+            raise ValueError("must not be the zero vector")
+        return tuple(c / length for c in n)
+
+
+class Prescribed(Section):
+    """A global translation prescribed as ``value * curve(t)``."""
+
+    type: Literal["prescribed"]
+    set: Name
+    translation: Axis
+    value: Real
+    curve: Name | None = None
+
+
+Boundary = Annotated[Union[Clamped, Fixed, Symmetry, Prescribed], Field(discriminator="type")]
+
+
+class Pressure(Section):
+    """Pressure ``value * curve(t)`` on a surface set. Positive pressure pushes along the
+    director (it inflates a tube whose directors point outward). ``follower``: acts normal
+    to the current surface on its current area (thesis 3.12.1); otherwise a dead load along
+    the initial normal on the initial area."""
+
+    type: Literal["pressure"]
+    set: Name = "all"
+    value: Real
+    curve: Name | None = None
+    follower: bool = True
+
+
+class EdgeForce(Section):
+    """Force per unit (initial) length along an edge set, global components."""
+
+    type: Literal["edge_force"]
+    set: Name
+    value: Vec3
+    curve: Name | None = None
+
+
+class EdgePressure(Section):
+    """Pressure on the shell's edge face along an edge set (force per unit edge length is
+    ``value`` times the current thickness), normal to the edge in the shell's tangent plane;
+    positive pushes into the shell, as a pressure does. Follows the deformation."""
+
+    type: Literal["edge_pressure"]
+    set: Name
+    value: Real
+    curve: Name | None = None
+
+
+class EdgeMoment(Section):
+    """Moment per unit (initial) length along an edge set, global components."""
+
+    type: Literal["edge_moment"]
+    set: Name
+    value: Vec3
+    curve: Name | None = None
+
+
+class PointForce(Section):
+    """Force on every node of a set, global components."""
+
+    type: Literal["point_force"]
+    set: Name
+    value: Vec3
+    curve: Name | None = None
+
+
+class PointMoment(Section):
+    """Moment on every node of a set, global components."""
+
+    type: Literal["point_moment"]
+    set: Name
+    value: Vec3
+    curve: Name | None = None
+
+
+class BodyForce(Section):
+    """Force per unit (initial) volume on a surface set, global components (self-weight is
+    density times gravity)."""
+
+    type: Literal["body_force"]
+    set: Name = "all"
+    value: Vec3
+    curve: Name | None = None
+
+
+Load = Annotated[
+    Union[Pressure, EdgeForce, EdgePressure, EdgeMoment, PointForce, PointMoment, BodyForce],
+    Field(discriminator="type"),
+]
+
+
+class Solver(Section):
+    """``[solver]``: central differences from t = 0 to ``end_time``.
+
+    Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
+    inverse), Δt_critical re-estimated every ``dt_update_every`` steps. ``mass``: lumped M1
+    (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
+    coefficient in 1/s (0 = undamped, the default)."""
+
+    end_time: Positive
+    dt_safety_factor: Positive = 1.25
+    dt_update_every: Count = 100
+    dt_max: Positive | None = None
+    mass: Literal["M1", "M2"] = "M2"
+    damping: NonNegative = 0.0
+
+
+OutputField = Literal[
+    "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
+    "pressure_band", "green_lagrange_strain", "von_mises",
+]
+VECTOR_QUANTITIES = ("displacement", "position", "director")
+TENSOR_QUANTITIES = ("stress", "strain")
+SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
+
+
+class Probe(Section):
+    """A history written at every output step: ``quantity`` at the node of a point set
+    (a set of several nodes gives their mean)."""
+
+    name: Name
+    quantity: Literal[
+        "displacement", "position", "director", "rotation", "thickness", "stress", "strain",
+        "pressure_band",
+    ]
+    set: Name
+    component: Literal[
+        "x", "y", "z", "magnitude", "xx", "yy", "zz", "xy", "yz", "zx", "scalar"
+    ] = "scalar"
+
+    @model_validator(mode="after")
+    def _component_fits(self) -> "Probe":
+        allowed = (
+            ("x", "y", "z", "magnitude") if self.quantity in VECTOR_QUANTITIES
+            else ("xx", "yy", "zz", "xy", "yz", "zx") if self.quantity in TENSOR_QUANTITIES
+            else ("scalar",)
+        )
+        if self.component not in allowed:
+            raise ValueError(
+                f"component '{self.component}' does not fit quantity '{self.quantity}'; "
+                f"expected one of {', '.join(allowed)}"
+            )
+        return self
+
+
+class Render(Section):
+    """A PNG written at the end of a run."""
+
+    field: OutputField = "pressure_band"
+    frame: Literal["last", "all"] | Count = "last"
+    view: Literal["iso", "top", "front", "side"] = "iso"
+    size: tuple[Count, Count] = (1200, 900)
+
+
+class Output(Section):
+    """``[output]``: frames every ``interval`` (or at the listed ``times``, which the time
+    stepper lands on exactly), the fields written, the formats, probes and renders."""
+
+    interval: Positive | None = None
+    times: list[NonNegative] | None = None
+    fields: list[OutputField] = ["displacement", "director", "thickness", "cauchy_stress", "pressure_band"]
+    formats: list[Literal["xdmf", "vtu"]] = ["xdmf"]
+    solid: bool = False
+    probe: list[Probe] = []
+    render: list[Render] = []
+
+    @model_validator(mode="after")
+    def _one_schedule(self) -> "Output":
+        if self.interval is not None and self.times is not None:
+            raise ValueError("give either 'interval' or 'times', not both")
+        if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
+            raise ValueError(f"'times' must be strictly increasing, got {self.times}")
+        names = [p.name for p in self.probe]
+        duplicates = sorted({n for n in names if names.count(n) > 1})
+        if duplicates:
+            raise ValueError(f"probe names must be unique; repeated: {', '.join(duplicates)}")
+        return self
+
+
+class Reference(Section):
+    """The value a verification deck is checked against.
+
+    ``measure`` turns the probe's history into one number: its ``final`` value, ``max``,
+    ``min``, ``amplitude`` (half the first peak-to-trough excursion, benchmarks 0.2),
+    ``first_peak_time``, or the value ``at_time`` ``time``. The check passes within
+    ``tolerance_percent`` of ``expected``, or within ``tolerance`` (absolute, in the
+    quantity's units) where a criterion is stated that way. ``source`` cites where
+    ``expected`` comes from (closed form, literature)."""
+
+    quantity: Annotated[str, Field(strict=True, min_length=1)]
+    probe: Name
+    measure: Literal["final", "max", "min", "amplitude", "first_peak_time", "at_time"] = "final"
+    time: NonNegative | None = None
+    expected: Real
+    tolerance_percent: Positive | None = None
+    tolerance: Positive | None = None
+    source: Annotated[str, Field(strict=True, min_length=3)]
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "Reference":
+        if (self.measure == "at_time") != (self.time is not None):
+            raise ValueError("'time' is needed with measure = 'at_time', and only then")
+        if (self.tolerance_percent is None) == (self.tolerance is None):
+            raise ValueError("give exactly one of 'tolerance_percent' and 'tolerance'")
+        if self.expected == 0.0 and self.tolerance is None:
+            raise ValueError("expected = 0 has no relative error; give an absolute 'tolerance'")
+        return self
+
+
+def _tag(table: object, key: str) -> str | None:
+    """The discriminating name of a raw table (builder, model), if it is a string."""
+    value = table.get(key) if isinstance(table, dict) else None
+    return value if isinstance(value, str) else None
+
+
+def _one_or_many(value: object) -> object:
+    """``[reference]`` (one) and ``[[reference]]`` (several) are both accepted."""
+    return [value] if isinstance(value, dict) else value
+
+
+class Deck(Section):
+    """A whole scene. Tables may come in any order; names are resolved after parsing."""
+
+    meta: Meta
+    geometry: Geometry
+    mesh: MeshOptions = MeshOptions()
+    material: Material
+    section: ShellSection
+    boundary: list[Boundary] = []
+    load: list[Load] = []
+    curves: dict[Name, Curve] = {}
+    solver: Solver
+    output: Output = Output()
+    reference: Annotated[list[Reference], BeforeValidator(_one_or_many)] = []
+
+    @model_validator(mode="before")
+    @classmethod
+    def _fill_defaults_that_depend_on_other_tables(cls, data: object) -> object:
+        """Builder-specific division defaults and the hyperelastic default technique."""
+        if not isinstance(data, dict):
+            return data
+        data = dict(data)
+        builder = BUILDERS.get(_tag(data.get("geometry"), "builder"))
+        mesh = data.get("mesh", {})
+        if builder is not None and isinstance(mesh, dict) and isinstance(mesh.get("divisions", {}), dict):
+            data["mesh"] = mesh | {"divisions": builder.DIVISIONS | mesh.get("divisions", {})}
+        model = MATERIALS.get(_tag(data.get("material"), "model"))
+        section = data.get("section")
+        if model is not None and model.HYPERELASTIC and isinstance(section, dict):
+            data["section"] = {"technique": 1} | section
+        return data
+
+    @model_validator(mode="after")
+    def _consistent(self) -> "Deck":
+        problems = []
+        known = type(self.geometry).DIVISIONS
+        for name in self.mesh.divisions:
+            if name not in known:
+                problems.append(
+                    f"mesh.divisions.{name}: builder '{self.geometry.builder}' has no division "
+                    f"'{name}'; expected {', '.join(known) or 'none (the file sets the mesh)'}"
+                )
+        if (self.mesh.boundaries_y0 or self.mesh.boundaries_y1) and self.geometry.builder != "rectangle":
+            problems.append("mesh.boundaries_y0/_y1: irregular element boundaries are for builder 'rectangle' only")
+        for key in ("boundaries_y0", "boundaries_y1"):
+            b = getattr(self.mesh, key)
+            n = self.mesh.divisions.get("length")
+            if b is not None and n is not None and len(b) != n + 1:
+                problems.append(
+                    f"mesh.{key}: {len(b)} boundaries for divisions.length = {n}; expected {n + 1}"
+                )
+        if self.geometry.builder == "tube" and self.mesh.divisions.get("around", 2) % 2:
+            problems.append(
+                f"mesh.divisions.around: the tube is built from two 45-degree patches, so it "
+                f"must be even, got {self.mesh.divisions['around']}"
+            )
+        if self.geometry.builder == "twisted_strip" and self.mesh.divisions.get("width", 2) % 2:
+            problems.append(
+                f"mesh.divisions.width: must be even so the tip centre is a node, "
+                f"got {self.mesh.divisions['width']}"
+            )
+        if self.material.HYPERELASTIC and self.section.technique is None:
+            problems.append("section.technique: a hyperelastic material needs a large-strain technique (1, 2 or 3)")
+        if problems:
+            raise ValueError("\n".join(problems))
+        return self
+
+    @property
+    def thickness_update(self) -> bool:
+        """Whether fibre lengths follow the deformation (thesis 3.11)."""
+        if self.section.thickness_update is not None:
+            return self.section.thickness_update
+        return self.section.technique is not None

@@ -1,0 +1,43 @@
+"""Shared test helpers: a minimal valid deck to build variants from."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+ROOT = Path(__file__).resolve().parents[1]
+DECKS = sorted((ROOT / "decks").rglob("*.toml"))
+
+BASE = """
+[meta]
+title = "test scene"
+
+[material]
+model = "linear_elastic"
+E = 1000.0
+nu = 0.3
+density = 1.0
+
+[section]
+thickness = 0.01
+
+[solver]
+end_time = 1.0
+"""
+
+
+def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
+    """A valid deck: ``base`` + [geometry] body + extra tables."""
+    return f"{base}\n[geometry]\n{geometry}\n{extra}"
+
+
+@pytest.fixture
+def scene():
+    """Parse a deck built by :func:`deck_text`."""
+    from shellsim.deck import parse_deck
+
+    return lambda geometry, extra="": parse_deck(deck_text(geometry, extra))

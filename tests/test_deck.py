@@ -1,0 +1,213 @@
+"""Decks: every shipped deck validates; every kind of mistake gives a message that names
+the key, the value and what was expected; no input ever ends in a traceback."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from shellsim.deck import deck_from_data, load_deck, parse_deck
+from shellsim.deck.curves import Curve
+from shellsim.errors import DeckError
+
+from .conftest import DECKS, deck_text
+
+RECTANGLE = 'builder = "rectangle"\nlength = 2.0\nwidth = 1.0'
+
+
+@pytest.mark.parametrize("path", DECKS, ids=lambda p: p.name)
+def test_every_shipped_deck_validates(path):
+    deck = load_deck(path)
+    assert deck.meta.title
+
+
+def problems_of(text: str) -> str:
+    with pytest.raises(DeckError) as caught:
+        parse_deck(text, name="broken.toml")
+    message = str(caught.value)
+    assert message.startswith("broken.toml:")
+    return message
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        pytest.param(deck_text(RECTANGLE).replace("E = 1000.0", 'E = "1000"'),
+                     ["material.E", "got '1000'", "expected a valid number"], id="wrong type"),
+        pytest.param(deck_text(RECTANGLE).replace("E = 1000.0", "Ee = 1000.0"),
+                     ["material.Ee", "unknown key 'Ee'", "did you mean 'E'", "material.E", "missing"],
+                     id="unknown key"),
+        pytest.param(deck_text(RECTANGLE).replace("thickness = 0.01", "points_through_thickness = 2"),
+                     ["section.thickness", "missing required value"], id="missing required value"),
+        pytest.param(deck_text(RECTANGLE).replace("thickness = 0.01", "thickness = -0.01"),
+                     ["section.thickness", "got -0.01", "greater than 0"], id="negative thickness"),
+        pytest.param(deck_text(RECTANGLE, '[[boundary]]\ntype = "clamped"\nset = "x_0"\n'),
+                     ["boundary[0].set", "unknown set 'x_0'", "did you mean 'x0'"], id="unknown named set"),
+        pytest.param(deck_text(RECTANGLE).replace("nu = 0.3", "nu = 0.5"),
+                     ["material.nu", "got 0.5", "got 0.5: a compressible model needs -1 < nu < 0.5"], id="nu >= 0.5"),
+        pytest.param(deck_text(RECTANGLE, "[curves.ramp]\nt = [0.0, 2.0, 1.0]\nvalue = [0.0, 1.0, 1.0]\n"),
+                     ["curves.ramp.t", "strictly increasing", "t[2] = 1.0"], id="curve not increasing in time"),
+        pytest.param(deck_text(RECTANGLE) + "\n[output\ninterval = 0.1\n",
+                     ["not valid TOML", "line"], id="bad TOML"),
+        pytest.param(deck_text('builder = "rectangel"\nlength = 2.0\nwidth = 1.0'),
+                     ["geometry.builder", "got 'rectangel'", "did you mean 'rectangle'"], id="unknown builder"),
+        pytest.param(deck_text(RECTANGLE, '[[load]]\ntype = "pressure"\nvalue = 1.0\ncurve = "rmap"\n'
+                                          "[curves.ramp]\nt = [0.0, 1.0]\nvalue = [0.0, 1.0]\n"),
+                     ["load[0].curve", "unknown curve 'rmap'", "did you mean 'ramp'"], id="unknown curve"),
+        pytest.param(deck_text(RECTANGLE, '[[load]]\ntype = "pressure"\nset = "x0"\nvalue = 1.0\n'),
+                     ["load[0].set", "'x0' is a edge set", "expected a surface set"], id="set of the wrong kind"),
+        pytest.param(deck_text(RECTANGLE).replace(
+            'model = "linear_elastic"\nE = 1000.0\nnu = 0.3', 'model = "mooney_rivlin"\nC1 = 1.0\nC2 = 0.5\nk = 100.0'),
+                     ["material.k", "no bulk modulus is needed"], id="bulk modulus for an incompressible model"),
+        pytest.param(deck_text(RECTANGLE, "[mesh]\ndivisions = { length = 2, axial = 3 }\n"),
+                     ["mesh.divisions.axial", "no division 'axial'", "length, width"], id="division of another builder"),
+        pytest.param(deck_text(RECTANGLE, '[[reference]]\nquantity = "w"\nprobe = "tip"\nexpected = 1.0\n'
+                                          'tolerance_percent = 1.0\nsource = "closed form"\n'),
+                     ["reference[0].probe", "unknown probe 'tip'"], id="reference to a missing probe"),
+        pytest.param(deck_text(RECTANGLE, '[mesh]\nboundaries_y0 = [0.0, 0.2, 0.5, 1.0]\n'),
+                     ["mesh.boundaries_y0", "4 boundaries for divisions.length = 2; expected 3"],
+                     id="irregular boundaries of the wrong count"),
+    ],
+)
+def test_broken_deck_names_the_key(text, expected):
+    message = problems_of(text)
+    for fragment in expected:
+        assert fragment in message, f"{fragment!r} not in:\n{message}"
+
+
+def test_messages_give_the_line_of_the_offending_key():
+    text = deck_text(RECTANGLE).replace("nu = 0.3", "nu = 0.7")
+    line = text.splitlines().index("nu = 0.7") + 1
+    assert f"material.nu (line {line})" in problems_of(text)
+
+
+def test_every_problem_is_reported_at_once():
+    text = deck_text(RECTANGLE).replace("nu = 0.3", "nu = 0.7").replace("end_time = 1.0", "end_time = 0.0")
+    message = problems_of(text)
+    assert "2 problems" in message and "material.nu" in message and "solver.end_time" in message
+
+
+def test_a_deck_states_only_what_its_scene_needs():
+    deck = parse_deck(deck_text(RECTANGLE))
+    assert deck.mesh.divisions == {"length": 2, "width": 2}
+    assert deck.section.points_through_thickness == 2
+    assert deck.solver.mass == "M2" and deck.solver.damping == 0.0
+    assert deck.section.technique is None and not deck.thickness_update
+
+
+def test_hyperelastic_material_defaults_to_technique_1():
+    text = deck_text(RECTANGLE).replace(
+        'model = "linear_elastic"\nE = 1000.0\nnu = 0.3', 'model = "neo_hookean"\nC1 = 1.0')
+    deck = parse_deck(text)
+    assert deck.section.technique == 1 and deck.thickness_update
+
+
+def test_missing_deck_file_is_a_deck_error(tmp_path):
+    with pytest.raises(DeckError, match="file not found"):
+        load_deck(tmp_path / "nowhere.toml")
+
+
+@pytest.mark.parametrize(
+    "interpolate, times, expected",
+    [
+        ("linear", [-1.0, 0.0, 0.5, 1.0, 1.5, 2.0, 3.0], [0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0]),
+        ("step", [0.0, 0.5, 1.0, 1.5, 2.0], [0.0, 0.0, 2.0, 2.0, 2.0]),
+        ("smooth", [0.0, 0.25, 0.5, 1.0], [0.0, 2.0 * (3 * 0.25**2 - 2 * 0.25**3), 1.0, 2.0]),
+    ],
+)
+def test_curves_interpolate_as_documented(interpolate, times, expected):
+    curve = Curve(t=[0.0, 1.0, 2.0], value=[0.0, 2.0, 2.0], interpolate=interpolate)
+    np.testing.assert_allclose(curve(np.array(times)), expected)
+    assert curve(times[1]) == pytest.approx(expected[1])
+
+
+def test_linear_extrapolation_continues_the_end_segments():
+    curve = Curve(t=[0.0, 1.0], value=[1.0, 3.0], extrapolate="linear")
+    np.testing.assert_allclose(curve(np.array([-1.0, 2.0])), [-1.0, 5.0])
+
+
+# --- no input ever ends in a traceback -------------------------------------------------
+
+VALID = tomllib.loads(deck_text(
+    RECTANGLE,
+    '[[boundary]]\ntype = "clamped"\nset = "x0"\n'
+    '[[load]]\ntype = "edge_force"\nset = "x1"\nvalue = [0.0, 0.0, 1.0]\ncurve = "ramp"\n'
+    "[curves.ramp]\nt = [0.0, 1.0]\nvalue = [0.0, 1.0]\n"
+    '[[output.probe]]\nname = "tip"\nquantity = "displacement"\nset = "x1y1"\ncomponent = "z"\n',
+))
+
+scalars = st.one_of(
+    st.none(), st.booleans(), st.integers(-10**6, 10**6), st.floats(allow_nan=True),
+    st.text(max_size=12), st.sampled_from(["rectangle", "tube", "guccione", "x0", "all", "M1", "ramp"]),
+)
+values = st.recursive(
+    scalars,
+    lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=8), inner, max_size=4)),
+    max_leaves=8,
+)
+
+
+def _paths(node, prefix=()):
+    yield prefix
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _paths(v, prefix + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _paths(v, prefix + (i,))
+
+
+PATHS = [p for p in _paths(VALID) if p]
+
+
+@st.composite
+def mutated_decks(draw):
+    data = copy.deepcopy(VALID)
+    for _ in range(draw(st.integers(1, 3))):
+        path = draw(st.sampled_from(PATHS))
+        parent = data
+        try:
+            for step in path[:-1]:
+                parent = parent[step]
+            action = draw(st.sampled_from(["replace", "delete", "add"]))
+            if action == "replace":
+                parent[path[-1]] = draw(values)
+            elif action == "delete" and isinstance(parent, dict):
+                parent.pop(path[-1], None)
+            elif isinstance(parent, dict):
+                parent[draw(st.text(max_size=8))] = draw(values)
+        except (KeyError, IndexError, TypeError):
+            continue  # an earlier mutation removed this path
+    return data
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(mutated_decks())
+def test_random_decks_validate_or_fail_with_a_deck_error(data):
+    try:
+        deck_from_data(data, name="random.toml")
+    except DeckError as error:
+        assert error.problems and all(isinstance(p, str) and p for p in error.problems)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.text(max_size=200))
+def test_random_text_never_escapes_as_anything_but_a_deck_error(text):
+    try:
+        parse_deck(deck_text(RECTANGLE) + "\n" + text, name="random.toml")
+    except DeckError:
+        pass
+
+
+def test_the_deck_reference_is_current():
+    from shellsim.deck.reference_doc import deck_reference
+
+    from .conftest import ROOT
+
+    assert (ROOT / "docs" / "decks.md").read_text() == deck_reference(), (
+        "docs/decks.md is stale: python -m shellsim.deck.reference_doc > docs/decks.md")

@@ -1,0 +1,61 @@
+"""Deck -> Mesh: the scene's geometry built with gmsh (or read from a file) as 9-node quads,
+consistently oriented, with directors, nodal thickness and named sets."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..deck import Deck, resolve_mesh_path
+from ..mesh import (
+    Mesh, NamedSet, averaged_directors, check_mesh, combine_surface_normals, orient_consistently,
+    snap_points,
+)
+
+__all__ = ["build_mesh"]
+
+
+def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
+    """The mesh of ``deck``; ``base_dir`` resolves a ``builder = 'file'`` path.
+
+    Directors are the exact surface normals of the built geometry (averaged where patches
+    meet); for a file, its own directors or else the averaged element normals.
+    Raises MeshError when the mesh cannot be built or fails the geometric checks.
+    """
+    g = deck.geometry
+    director = thickness = None
+    surface_normals: list = []
+    if g.builder == "file":
+        from .importing import read_mesh
+
+        imported = read_mesh(resolve_mesh_path(deck, base_dir))
+        x, conn, sets = imported.x, imported.conn, imported.sets
+        director, thickness = imported.director, imported.thickness
+        preferred = director[conn[:, 8]] if director is not None else None
+    else:
+        from . import builders
+        from .gmsh_extract import extract
+        from .session import gmsh_session
+
+        with gmsh_session(name=g.builder) as gmsh:
+            sketch = builders.Sketch(gmsh)
+            hint = builders.BUILDERS[g.builder](sketch, g, deck.mesh, deck.section.thickness)
+            sketch.finish()
+            x, conn, sets, surface_normals = extract(gmsh, f"builder '{g.builder}'")
+        if g.builder == "twisted_strip":
+            x, normals = builders.twist_onto_helicoid(x, g)
+            surface_normals = [(np.arange(len(x)), normals)]
+        preferred = hint(x[conn[:, 8]])
+    conn = orient_consistently(x, conn, preferred)
+    if director is None:
+        director = combine_surface_normals(averaged_directors(x, conn), surface_normals)
+    if thickness is None:
+        thickness = np.full(len(x), deck.section.thickness)
+    all_elements = np.arange(len(conn))
+    sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
+    sets = sets | snap_points(x, deck.mesh.points)
+    mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets)
+    check_mesh(mesh, deck.section.points_through_thickness)
+    return mesh
+

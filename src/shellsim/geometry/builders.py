@@ -1,0 +1,300 @@
+"""Scene geometries built with gmsh's built-in kernel as structured (transfinite) patches.
+
+Each builder draws its mid-surface, sets element divisions on every curve and names the
+sets its ``[geometry]`` model declares (:meth:`shellsim.deck.geometry.Rectangle.sets` and
+siblings). Curved patches are exact: circle arcs, cylinders filled by transfinite
+interpolation of arcs and straight lines, and sphere patches filled with gmsh's spherical
+filling, so second-order nodes lie on the true surface. The pre-twisted strip is meshed
+flat and its nodes mapped exactly onto the helicoid (gmsh's twist extrusion puts the
+second-order nodes off it).
+
+A builder returns an *orientation hint*: a function of positions (n, 3) giving the
+direction (n, 3) the shell normal, and so the directors, should point to.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from ..deck.geometry import (
+    AnnularSector, CylindricalPanel, Hemisphere, PlateWithHole, Rectangle, Tube, TwistedStrip,
+)
+from ..deck.schema import MeshOptions
+
+Hint = Callable[[np.ndarray], np.ndarray]
+
+
+def _up(x: np.ndarray) -> np.ndarray:
+    return np.broadcast_to([0.0, 0.0, 1.0], x.shape)
+
+
+class Sketch:
+    """Points, curves with their element counts, structured patches and named groups in the
+    built-in kernel. A curve asked for twice (either way round) is created once, so
+    neighbouring patches share it and the mesh is conforming."""
+
+    def __init__(self, gmsh: Any):
+        self.gmsh = gmsh
+        self.geo = gmsh.model.geo
+        self._curves: dict[frozenset, tuple[int, int, int]] = {}
+        self._groups: dict[tuple[int, str], list[int]] = {}
+
+    def point(self, xyz: tuple[float, float, float] | np.ndarray) -> int:
+        return self.geo.addPoint(*map(float, xyz))
+
+    def line(self, a: int, b: int, divisions: int) -> int:
+        return self._curve(a, b, divisions, lambda: self.geo.addLine(a, b))
+
+    def arc(self, a: int, centre: int, b: int, divisions: int) -> int:
+        return self._curve(a, b, divisions, lambda: self.geo.addCircleArc(a, centre, b))
+
+    def _curve(self, a: int, b: int, divisions: int, make: Callable[[], int]) -> int:
+        """Signed tag of the curve from a to b (negative when it exists from b to a)."""
+        key = frozenset((a, b))
+        if key not in self._curves:
+            tag = make()
+            self.geo.mesh.setTransfiniteCurve(tag, divisions + 1)
+            self._curves[key] = (tag, a, divisions)
+        tag, start, n = self._curves[key]
+        assert n == divisions, "a shared curve must keep its division count"
+        return tag if start == a else -tag
+
+    def patch(self, curves: list[int], flat: bool = False, sphere_centre: int = -1) -> int:
+        """A structured four-sided patch bounded by ``curves`` (signed, in loop order)."""
+        loop = self.geo.addCurveLoop(curves)
+        if flat:
+            surface = self.geo.addPlaneSurface([loop])
+        else:
+            surface = self.geo.addSurfaceFilling([loop], sphereCenterTag=sphere_centre)
+        self.geo.mesh.setTransfiniteSurface(surface)
+        self.geo.mesh.setRecombine(2, surface)
+        return surface
+
+    def name(self, dim: int, name: str, tags: list[int]) -> None:
+        """Add entities (signs dropped) to the named set ``name`` of dimension ``dim``."""
+        self._groups.setdefault((dim, name), []).extend(abs(t) for t in tags)
+
+    def finish(self) -> None:
+        """Synchronise, mesh as complete 9-node quads, create the physical groups."""
+        self.geo.synchronize()
+        for (dim, name), tags in self._groups.items():
+            self.gmsh.model.addPhysicalGroup(dim, sorted(set(tags)), name=name)
+        self.gmsh.model.mesh.generate(2)
+        self.gmsh.model.mesh.setOrder(2)
+
+
+def rectangle(sk: Sketch, g: Rectangle, mesh: MeshOptions, thickness: float) -> Hint:
+    nx, ny = mesh.divisions["length"], mesh.divisions["width"]
+    regular = np.linspace(0.0, 1.0, nx + 1)
+    b0 = np.asarray(mesh.boundaries_y0 if mesh.boundaries_y0 is not None else regular)
+    b1 = np.asarray(mesh.boundaries_y1 if mesh.boundaries_y1 is not None else regular)
+    # One patch per element column, so element boundaries may differ along the two edges.
+    bottom = [sk.point((g.length * f, 0.0, 0.0)) for f in b0]
+    top = [sk.point((g.length * f, g.width, 0.0)) for f in b1]
+    for i in range(nx):
+        sk.patch(
+            [sk.line(bottom[i], bottom[i + 1], 1), sk.line(bottom[i + 1], top[i + 1], ny),
+             sk.line(top[i + 1], top[i], 1), sk.line(top[i], bottom[i], ny)],
+            flat=True,
+        )
+    sk.name(1, "x0", [sk.line(bottom[0], top[0], ny)])
+    sk.name(1, "x1", [sk.line(bottom[-1], top[-1], ny)])
+    sk.name(1, "y0", [sk.line(a, b, 1) for a, b in zip(bottom, bottom[1:])])
+    sk.name(1, "y1", [sk.line(a, b, 1) for a, b in zip(top, top[1:])])
+    for name, p in (("x0y0", bottom[0]), ("x1y0", bottom[-1]), ("x1y1", top[-1]), ("x0y1", top[0])):
+        sk.name(0, name, [p])
+    return _up
+
+
+def cylindrical_panel(sk: Sketch, g: CylindricalPanel, mesh: MeshOptions, thickness: float) -> Hint:
+    n_around, n_along = mesh.divisions["around"], mesh.divisions["along"]
+    phi = math.radians(g.angle_deg)
+
+    def at(angle: float, y: float) -> int:
+        return sk.point((g.radius * math.sin(angle), y, g.radius * math.cos(angle)))
+
+    c0, c1 = sk.point((0.0, 0.0, 0.0)), sk.point((0.0, g.length, 0.0))
+    p00, p10, p11, p01 = at(0, 0), at(phi, 0), at(phi, g.length), at(0, g.length)
+    sk.patch([sk.arc(p00, c0, p10, n_around), sk.line(p10, p11, n_along),
+              sk.arc(p11, c1, p01, n_around), sk.line(p01, p00, n_along)])
+    sk.name(1, "phi0", [sk.line(p00, p01, n_along)])
+    sk.name(1, "phi1", [sk.line(p10, p11, n_along)])
+    sk.name(1, "y0", [sk.arc(p00, c0, p10, n_around)])
+    sk.name(1, "y1", [sk.arc(p01, c1, p11, n_around)])
+    for name, p in (("phi0_y0", p00), ("phi1_y0", p10), ("phi1_y1", p11), ("phi0_y1", p01)):
+        sk.name(0, name, [p])
+    return lambda x: x * np.array([1.0, 0.0, 1.0])
+
+
+def twisted_strip(sk: Sketch, g: TwistedStrip, mesh: MeshOptions, thickness: float) -> Hint:
+    """Meshed flat here; :func:`twist_onto_helicoid` maps the nodes afterwards."""
+    nx, nw = mesh.divisions["length"], mesh.divisions["width"]
+    half = g.width / 2
+    r0, r1 = sk.point((0.0, -half, 0.0)), sk.point((0.0, half, 0.0))
+    t0, t1 = sk.point((g.length, -half, 0.0)), sk.point((g.length, half, 0.0))
+    rc, tc = sk.point((0.0, 0.0, 0.0)), sk.point((g.length, 0.0, 0.0))
+    half_w = nw // 2
+    sk.patch([sk.line(r0, t0, nx), sk.line(t0, tc, half_w), sk.line(tc, rc, nx),
+              sk.line(rc, r0, half_w)], flat=True)
+    sk.patch([sk.line(rc, tc, nx), sk.line(tc, t1, half_w), sk.line(t1, r1, nx),
+              sk.line(r1, rc, half_w)], flat=True)
+    sk.name(1, "root", [sk.line(r0, rc, half_w), sk.line(rc, r1, half_w)])
+    sk.name(1, "tip", [sk.line(t0, tc, half_w), sk.line(tc, t1, half_w)])
+    sk.name(1, "side0", [sk.line(r0, t0, nx)])
+    sk.name(1, "side1", [sk.line(r1, t1, nx)])
+    sk.name(0, "tip_centre", [tc])
+    twist = math.radians(g.twist_deg)
+
+    def hint(x: np.ndarray) -> np.ndarray:
+        a = twist * x[:, 0] / g.length
+        return np.column_stack([np.zeros_like(a), -np.sin(a), np.cos(a)])
+
+    return hint
+
+
+def twist_onto_helicoid(x: np.ndarray, g: TwistedStrip) -> tuple[np.ndarray, np.ndarray]:
+    """Map flat-strip positions (x, w, 0) to (x, w cos a, w sin a), a = twist x / length.
+
+    Returns the mapped positions (n, 3) and the helicoid's unit normals there (n, 3):
+    (x_,x) cross (x_,w) = (-w a', -sin a, cos a), a' = twist / length.
+    """
+    rate = math.radians(g.twist_deg) / g.length
+    a, w = rate * x[:, 0], x[:, 1]
+    mapped = np.column_stack([x[:, 0], w * np.cos(a), w * np.sin(a)])
+    normal = np.column_stack([-w * rate, -np.sin(a), np.cos(a)])
+    return mapped, normal / np.linalg.norm(normal, axis=1, keepdims=True)
+
+
+def annular_sector(sk: Sketch, g: AnnularSector, mesh: MeshOptions, thickness: float) -> Hint:
+    n_around, n_radial = mesh.divisions["around"], mesh.divisions["radial"]
+    theta = math.radians(g.angle_deg)
+    o = sk.point((0.0, 0.0, 0.0))
+    i0, o0 = sk.point((g.inner_radius, 0.0, 0.0)), sk.point((g.outer_radius, 0.0, 0.0))
+    o1 = sk.point((g.outer_radius * math.cos(theta), g.outer_radius * math.sin(theta), 0.0))
+    i1 = sk.point((g.inner_radius * math.cos(theta), g.inner_radius * math.sin(theta), 0.0))
+    sk.patch([sk.line(i0, o0, n_radial), sk.arc(o0, o, o1, n_around),
+              sk.line(o1, i1, n_radial), sk.arc(i1, o, i0, n_around)], flat=True)
+    sk.name(1, "inner", [sk.arc(i0, o, i1, n_around)])
+    sk.name(1, "outer", [sk.arc(o0, o, o1, n_around)])
+    sk.name(1, "theta0", [sk.line(i0, o0, n_radial)])
+    sk.name(1, "theta1", [sk.line(i1, o1, n_radial)])
+    for name, p in (("inner_theta0", i0), ("outer_theta0", o0), ("outer_theta1", o1), ("inner_theta1", i1)):
+        sk.name(0, name, [p])
+    return _up
+
+
+def plate_with_hole(sk: Sketch, g: PlateWithHole, mesh: MeshOptions, thickness: float) -> Hint:
+    n_around, n_radial = mesh.divisions["around"], mesh.divisions["radial"]
+    a, w = g.hole_radius, g.half_width
+    o = sk.point((0.0, 0.0, 0.0))
+    pa, pb = sk.point((a, 0.0, 0.0)), sk.point((0.0, a, 0.0))
+    pd = sk.point((a / math.sqrt(2), a / math.sqrt(2), 0.0))
+    pe, pc, pf = sk.point((w, 0.0, 0.0)), sk.point((w, w, 0.0)), sk.point((0.0, w, 0.0))
+    sk.patch([sk.arc(pa, o, pd, n_around), sk.line(pd, pc, n_radial),
+              sk.line(pc, pe, n_around), sk.line(pe, pa, n_radial)], flat=True)
+    sk.patch([sk.arc(pd, o, pb, n_around), sk.line(pb, pf, n_radial),
+              sk.line(pf, pc, n_around), sk.line(pc, pd, n_radial)], flat=True)
+    sk.name(1, "hole", [sk.arc(pa, o, pd, n_around), sk.arc(pd, o, pb, n_around)])
+    sk.name(1, "x0", [sk.line(pb, pf, n_radial)])
+    sk.name(1, "y0", [sk.line(pa, pe, n_radial)])
+    sk.name(1, "x1", [sk.line(pe, pc, n_around)])
+    sk.name(1, "y1", [sk.line(pf, pc, n_around)])
+    for name, p in (("A", pa), ("B", pb), ("C", pc)):
+        sk.name(0, name, [p])
+    return _up
+
+
+def _sphere_octant(sk: Sketch, centre: tuple[float, float, float], radius: float, n: int,
+                   equator: tuple[int, int, int] | None = None) -> dict[str, list[int]]:
+    """The octant x, y >= 0 above ``centre`` of a sphere, as three patches meeting at the
+    octant's centre point; every patch edge is a great-circle arc.
+
+    ``equator``: existing points (on x, at 45 degrees, on y) to share with a neighbour.
+    Returns the patch surfaces and the curves of its equator, x = 0 and y = 0 boundaries.
+    """
+    c = np.asarray(centre)
+    s2, s3 = 1 / math.sqrt(2), 1 / math.sqrt(3)
+
+    def at(direction: tuple[float, float, float]) -> int:
+        return sk.point(c + radius * np.asarray(direction))
+
+    o = sk.point(c)
+    ex, em, ey = equator or (at((1, 0, 0)), at((s2, s2, 0)), at((0, 1, 0)))
+    pole, mx, my, mid = at((0, 0, 1)), at((s2, 0, s2)), at((0, s2, s2)), at((s3, s3, s3))
+    surfaces = [
+        sk.patch([sk.arc(ex, o, em, n), sk.arc(em, o, mid, n), sk.arc(mid, o, mx, n),
+                  sk.arc(mx, o, ex, n)], sphere_centre=o),
+        sk.patch([sk.arc(em, o, ey, n), sk.arc(ey, o, my, n), sk.arc(my, o, mid, n),
+                  sk.arc(mid, o, em, n)], sphere_centre=o),
+        sk.patch([sk.arc(mx, o, mid, n), sk.arc(mid, o, my, n), sk.arc(my, o, pole, n),
+                  sk.arc(pole, o, mx, n)], sphere_centre=o),
+    ]
+    return {
+        "surfaces": surfaces,
+        "equator": [sk.arc(ex, o, em, n), sk.arc(em, o, ey, n)],
+        "sym_y": [sk.arc(ex, o, mx, n), sk.arc(mx, o, pole, n)],
+        "sym_x": [sk.arc(ey, o, my, n), sk.arc(my, o, pole, n)],
+        "points": [ex, ey, pole],
+    }
+
+
+def hemisphere(sk: Sketch, g: Hemisphere, mesh: MeshOptions, thickness: float) -> Hint:
+    octant = _sphere_octant(sk, (0.0, 0.0, 0.0), g.radius, mesh.divisions["patch"])
+    for name in ("equator", "sym_x", "sym_y"):
+        sk.name(1, name, octant[name])
+    for name, p in zip(("equator_x", "equator_y", "pole"), octant["points"]):
+        sk.name(0, name, [p])
+    return lambda x: x
+
+
+def tube(sk: Sketch, g: Tube, mesh: MeshOptions, thickness: float) -> Hint:
+    n, n_axial = mesh.divisions["around"] // 2, mesh.divisions["axial"]
+    r = g.inner_radius + thickness / 2
+    s2 = 1 / math.sqrt(2)
+    rings = []
+    for z in (0.0, g.length):
+        centre = sk.point((0.0, 0.0, z))
+        rings.append((centre, sk.point((r, 0.0, z)), sk.point((r * s2, r * s2, z)), sk.point((0.0, r, z))))
+    (o0, x0, m0, y0), (o1, x1, m1, y1) = rings
+    wall = [
+        sk.patch([sk.arc(x0, o0, m0, n), sk.line(m0, m1, n_axial), sk.arc(m1, o1, x1, n),
+                  sk.line(x1, x0, n_axial)]),
+        sk.patch([sk.arc(m0, o0, y0, n), sk.line(y0, y1, n_axial), sk.arc(y1, o1, m1, n),
+                  sk.line(m1, m0, n_axial)]),
+    ]
+    sk.name(2, "wall", wall)
+    sk.name(1, "sym_y", [sk.line(x0, x1, n_axial)])
+    sk.name(1, "sym_x", [sk.line(y0, y1, n_axial)])
+    sk.name(1, "z0", [sk.arc(x0, o0, m0, n), sk.arc(m0, o0, y0, n)])
+    sk.name(0, "z0_x", [x0])
+    sk.name(0, "z0_y", [y0])
+    if g.cap == "hemisphere":
+        cap = _sphere_octant(sk, (0.0, 0.0, g.length), r, n, equator=(x1, m1, y1))
+        sk.name(2, "cap", cap["surfaces"])
+        sk.name(1, "sym_y", cap["sym_y"])
+        sk.name(1, "sym_x", cap["sym_x"])
+        sk.name(0, "pole", [cap["points"][2]])
+    else:
+        sk.name(1, "end", [sk.arc(x1, o1, m1, n), sk.arc(m1, o1, y1, n)])
+
+    def outward(x: np.ndarray) -> np.ndarray:
+        axis_point = np.zeros_like(x)
+        axis_point[:, 2] = np.clip(x[:, 2], 0.0, g.length)
+        return x - axis_point
+
+    return outward
+
+
+BUILDERS = {
+    "rectangle": rectangle,
+    "cylindrical_panel": cylindrical_panel,
+    "twisted_strip": twisted_strip,
+    "annular_sector": annular_sector,
+    "plate_with_hole": plate_with_hole,
+    "tube": tube,
+    "hemisphere": hemisphere,
+}

@@ -1,0 +1,217 @@
+"""The shell mesh as flat arrays, and the geometric facts derived from it: consistent
+element orientation, nodal directors, Jacobians, area, named points.
+
+Node order inside an element is the thesis' (:mod:`shellsim.element.shape`).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
+from .errors import MeshError
+
+#: Node permutation that reverses an element's orientation (swaps r and s).
+FLIP = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])
+
+
+@dataclass(frozen=True)
+class NamedSet:
+    """Nodes of a named set and, for edge and surface sets, the pieces they are made of.
+
+    kind : 'surface', 'edge' or 'point'.
+    nodes : (k,) int — sorted node indices.
+    elements : (m,) int — element indices (surface sets).
+    edges : (m, 3) int — element edges as (corner, mid-side, corner) node triples (edge sets).
+    """
+
+    kind: str
+    nodes: np.ndarray
+    elements: np.ndarray | None = None
+    edges: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A shell mesh of 9-node quadrilaterals.
+
+    x : (n_nodes, 3) float — mid-surface node positions.
+    conn : (n_elements, 9) int — node indices per element, thesis order.
+    director : (n_nodes, 3) float — unit nodal directors.
+    thickness : (n_nodes,) float — nodal fibre lengths h_a.
+    sets : name -> NamedSet.
+    """
+
+    x: np.ndarray
+    conn: np.ndarray
+    director: np.ndarray
+    thickness: np.ndarray
+    sets: dict[str, NamedSet] = field(default_factory=dict)
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.x)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.conn)
+
+
+def tangents(x: np.ndarray, conn: np.ndarray, rs: np.ndarray) -> np.ndarray:
+    """Surface tangents g_r = dx/dr, g_s = dx/ds at natural points ``rs``.
+
+    Shapes: x (n, 3), conn (ne, 9), rs (q, 2) -> (ne, q, 2, 3).
+    """
+    return np.einsum("qad,eai->eqdi", shape_derivatives(rs), x[conn])
+
+
+def element_normals(x: np.ndarray, conn: np.ndarray, rs: np.ndarray) -> np.ndarray:
+    """Unnormalised normals g_r x g_s at ``rs``: (ne, q, 3); their length is the area density."""
+    g = tangents(x, conn, rs)
+    return np.cross(g[:, :, 0], g[:, :, 1])
+
+
+def orient_consistently(x: np.ndarray, conn: np.ndarray, preferred: np.ndarray | None) -> np.ndarray:
+    """Connectivity with every element ordered so that neighbours agree on the normal.
+
+    Neighbours sharing an edge must walk it in opposite directions; walking the element
+    graph breadth-first flips those that do not. In each connected piece the first element
+    is the one whose normal lines up best with its ``preferred`` direction (ne, 3), if
+    given, and it is turned to agree with it. Returns a new (ne, 9) array.
+    """
+    conn = conn.copy()
+    n_el = len(conn)
+    centre_normal = element_normals(x, conn, np.zeros((1, 2)))[:, 0]
+    alignment = np.zeros(n_el)
+    if preferred is not None:
+        h = preferred
+        alignment = np.einsum("ei,ei->e", centre_normal, h) / (
+            np.linalg.norm(centre_normal, axis=1) * np.linalg.norm(h, axis=1) + 1e-300
+        )
+    by_edge: dict[tuple[int, int], list[int]] = {}
+    for e, nodes in enumerate(conn):
+        for a, _, b in EDGES:
+            by_edge.setdefault((min(nodes[a], nodes[b]), max(nodes[a], nodes[b])), []).append(e)
+    flipped = np.zeros(n_el, dtype=bool)
+    seen = np.zeros(n_el, dtype=bool)
+    for seed in np.argsort(-np.abs(alignment)):
+        if seen[seed]:
+            continue
+        seen[seed] = True
+        if alignment[seed] < 0:
+            conn[seed] = conn[seed][FLIP]
+            flipped[seed] = True
+        queue = deque([seed])
+        while queue:
+            e = queue.popleft()
+            walked = {(conn[e][a], conn[e][b]) for a, _, b in EDGES}
+            for a, _, b in EDGES:
+                key = (min(conn[e][a], conn[e][b]), max(conn[e][a], conn[e][b]))
+                for other in by_edge[key]:
+                    if seen[other]:
+                        continue
+                    seen[other] = True
+                    other_walks = {(conn[other][p], conn[other][q]) for p, _, q in EDGES}
+                    if walked & other_walks:
+                        conn[other] = conn[other][FLIP]
+                    queue.append(other)
+    return conn
+
+
+def averaged_directors(x: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """Unit directors: the mean of the unit normals of the elements meeting at each node,
+    each evaluated at the node itself. Shapes: (n, 3), (ne, 9) -> (n, 3)."""
+    normals = element_normals(x, conn, NODE_RS)  # (ne, 9 node positions, 3)
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    total = np.zeros_like(x)
+    np.add.at(total, conn, normals)
+    length = np.linalg.norm(total, axis=1, keepdims=True)
+    if np.any(length < 1e-12):
+        raise MeshError("a node's element normals cancel out (the mesh folds back on itself)")
+    return total / length
+
+
+def combine_surface_normals(reference: np.ndarray, pieces: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """Unit directors from exact surface normals given per surface patch.
+
+    Each patch's normals are signed to agree with ``reference`` (n, 3), the directors of the
+    oriented elements, then averaged where patches meet. Nodes on no patch keep
+    ``reference``. ``pieces``: list of (nodes (k,), normals (k, 3)).
+    """
+    total = np.zeros_like(reference)
+    for nodes, normals in pieces:
+        sign = np.sign(np.einsum("ki,ki->k", normals, reference[nodes]))
+        np.add.at(total, nodes, sign[:, None] * normals)
+    length = np.linalg.norm(total, axis=1, keepdims=True)
+    return np.where(length > 1e-12, total / np.maximum(length, 1e-300), reference)
+
+
+def jacobian_determinants(mesh: Mesh, n_inplane: int = 3, n_thick: int = 2) -> np.ndarray:
+    """det of the 3D Jacobian [dx/dr, dx/ds, dx/dt] of the shell body at the Gauss points,
+    x(r, s, t) = sum_a N_a (x_a + t h_a/2 d_a). Returns (ne, n_inplane**2, n_thick)."""
+    rs, _ = gauss_rule_2d(n_inplane)
+    t, _ = gauss_rule(n_thick)
+    n = shape(rs)  # (q, 9)
+    dn = shape_derivatives(rs)  # (q, 9, 2)
+    xe = mesh.x[mesh.conn]  # (ne, 9, 3)
+    fibre = (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]  # (ne, 9, 3)
+    g = np.einsum("qad,eai->eqdi", dn, xe)  # (ne, q, 2, 3)
+    gf = np.einsum("qad,eai->eqdi", dn, fibre)  # (ne, q, 2, 3)
+    f = np.einsum("qa,eai->eqi", n, fibre)  # (ne, q, 3) = dx/dt
+    dets = []
+    for tk in t:
+        gr, gs = g[:, :, 0] + tk * gf[:, :, 0], g[:, :, 1] + tk * gf[:, :, 1]
+        dets.append(np.einsum("eqi,eqi->eq", np.cross(gr, gs), f))
+    return np.stack(dets, axis=-1)
+
+
+def check_mesh(mesh: Mesh, n_thick: int = 2) -> None:
+    """Raise MeshError unless every element has 9 nodes and a positive Jacobian at every
+    Gauss point (3 x 3 in-plane, ``n_thick`` through the thickness)."""
+    if mesh.conn.ndim != 2 or mesh.conn.shape[1] != 9:
+        raise MeshError(f"elements must have 9 nodes, got connectivity of shape {mesh.conn.shape}")
+    det = jacobian_determinants(mesh, 3, n_thick)
+    bad = np.unique(np.nonzero(det <= 0)[0])
+    if len(bad):
+        raise MeshError(
+            f"{len(bad)} element(s) have a non-positive Jacobian (folded, or thicker than "
+            f"their curvature allows), e.g. element {bad[0]} with nodes {mesh.conn[bad[0]].tolist()}"
+        )
+
+
+def mid_surface_area(mesh: Mesh, n_gauss: int = 3) -> float:
+    """Area of the mid-surface by Gauss quadrature of |g_r x g_s|."""
+    rs, w = gauss_rule_2d(n_gauss)
+    return float(np.einsum("eq,q->", np.linalg.norm(element_normals(mesh.x, mesh.conn, rs), axis=-1), w))
+
+
+def edges_within(conn: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """Element edges whose three nodes all belong to ``nodes``, each once: (m, 3)."""
+    member = np.zeros(conn.max() + 1, dtype=bool)
+    member[nodes] = True
+    triples = conn[:, EDGES].reshape(-1, 3)
+    inside = triples[member[triples].all(axis=1)]
+    _, first = np.unique(np.sort(inside, axis=1), axis=0, return_index=True)
+    return inside[np.sort(first)]
+
+
+def snap_points(x: np.ndarray, points: dict[str, tuple[float, float, float]]) -> dict[str, NamedSet]:
+    """Named point sets at the nodes that coincide with the given positions.
+
+    A position farther than 1e-6 of the model size from every node is an error (it would
+    silently probe the wrong place)."""
+    size = float(np.linalg.norm(x.max(axis=0) - x.min(axis=0))) or 1.0
+    sets = {}
+    for name, p in points.items():
+        distance = np.linalg.norm(x - np.asarray(p), axis=1)
+        nearest = int(np.argmin(distance))
+        if distance[nearest] > 1e-6 * size:
+            raise MeshError(
+                f"mesh.points.{name}: {list(p)} is not at a node; the nearest node is "
+                f"{x[nearest].round(12).tolist()}, {distance[nearest]:.4g} away"
+            )
+        sets[name] = NamedSet("point", np.array([nearest]))
+    return sets

@@ -1,0 +1,289 @@
+"""Meshes from every builder: 9 nodes in the element's order on the exact surface, positive
+Jacobians, exact areas, the right nodes in every named set, directors, and file import."""
+
+from __future__ import annotations
+
+import math
+import signal
+import threading
+
+import numpy as np
+import pytest
+
+from shellsim.element.shape import NODE_RS, shape, shape_derivatives
+from shellsim.errors import MeshError
+from shellsim.geometry import build_mesh
+from shellsim.geometry.session import gmsh_session
+from shellsim.mesh import jacobian_determinants, mid_surface_area
+
+from .conftest import deck_text
+
+T = 0.01  # section thickness of the test decks
+RM = 1.0 + T / 2  # tube mid-surface radius for inner radius 1
+
+RNG = np.random.default_rng(3)
+INTERIOR = RNG.uniform(-1, 1, size=(12, 2))
+
+
+def helicoid_area(length, width, twist):
+    """Area of (x, w cos a, w sin a), a = twist x / length: length * int sqrt(1 + (k w)^2) dw."""
+    k = twist / length
+    h = width / 2
+    return length * (h * math.sqrt(1 + (k * h) ** 2) + math.asinh(k * h) / k)
+
+
+# builder: (geometry table, [mesh] table, exact area, distance of a point from the exact surface)
+BUILDERS = {
+    "rectangle": ('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "", 2.0, lambda p: p[:, 2]),
+    "cylindrical_panel": (
+        'builder = "cylindrical_panel"\nradius = 25.0\nlength = 25.0\nangle_deg = 40.0',
+        "divisions = { around = 4, along = 2 }", 25.0 * 25.0 * math.radians(40),
+        lambda p: np.hypot(p[:, 0], p[:, 2]) - 25.0),
+    "twisted_strip": (
+        'builder = "twisted_strip"\nlength = 12.0\nwidth = 1.1', "divisions = { length = 8, width = 2 }",
+        helicoid_area(12.0, 1.1, math.pi / 2),
+        lambda p: p[:, 1] * np.sin(math.pi / 2 * p[:, 0] / 12) - p[:, 2] * np.cos(math.pi / 2 * p[:, 0] / 12)),
+    "annular_sector": (
+        'builder = "annular_sector"\ninner_radius = 3.0\nouter_radius = 9.0', "divisions = { around = 4, radial = 2 }",
+        math.pi / 4 * (81 - 9), lambda p: p[:, 2]),
+    "plate_with_hole": (
+        'builder = "plate_with_hole"\nhalf_width = 0.05\nhole_radius = 0.025', "divisions = { around = 2, radial = 1 }",
+        0.05**2 - math.pi * 0.025**2 / 4, lambda p: p[:, 2]),
+    "tube": (
+        'builder = "tube"\ninner_radius = 1.0\nlength = 4.0', "divisions = { around = 4, axial = 4 }",
+        math.pi / 2 * RM * 4.0, lambda p: np.hypot(p[:, 0], p[:, 1]) - RM),
+    "tube_with_cap": (
+        'builder = "tube"\ninner_radius = 1.0\nlength = 4.0\ncap = "hemisphere"', "divisions = { around = 4, axial = 4 }",
+        math.pi / 2 * RM * 4.0 + math.pi / 2 * RM**2,
+        lambda p: np.where(p[:, 2] <= 4.0, np.hypot(p[:, 0], p[:, 1]),
+                           np.linalg.norm(p - [0, 0, 4.0], axis=1)) - RM),
+    "hemisphere": (
+        'builder = "hemisphere"\nradius = 10.0', "divisions = { patch = 2 }", math.pi / 2 * 100.0,
+        lambda p: np.linalg.norm(p, axis=1) - 10.0),
+}
+
+
+def build(geometry: str, mesh: str = "", extra: str = ""):
+    from shellsim.deck import parse_deck
+
+    deck = parse_deck(deck_text(geometry, f"[mesh]\n{mesh}\n{extra}").replace("thickness = 0.01", f"thickness = {T}"))
+    return deck, build_mesh(deck)
+
+
+@pytest.fixture(scope="module", params=list(BUILDERS))
+def built(request):
+    geometry, mesh, area, distance = BUILDERS[request.param]
+    deck, m = build(geometry, mesh)
+    return request.param, deck, m, area, distance
+
+
+def test_elements_have_nine_nodes_and_positive_jacobians(built):
+    _, _, mesh, _, _ = built
+    assert mesh.conn.shape[1] == 9
+    assert len(np.unique(mesh.conn)) == mesh.n_nodes  # every node used, numbered from 0
+    assert np.all(jacobian_determinants(mesh, 3, 2) > 0)
+
+
+def test_nodes_and_interpolated_points_lie_on_the_exact_surface(built):
+    """Nodes are on the surface; the isoparametric map between them stays within the
+    second-order geometric error, which a wrong node order would exceed by far."""
+    name, _, mesh, _, distance = built
+    size = np.ptp(mesh.x, axis=0).max()
+    assert np.abs(distance(mesh.x)).max() < 1e-9 * size
+    inside = np.einsum("qa,eai->eqi", shape(INTERIOR), mesh.x[mesh.conn]).reshape(-1, 3)
+    assert np.abs(distance(inside)).max() < 2e-3 * size
+
+
+def test_mid_surface_area_matches_the_exact_area(built):
+    _, _, mesh, area, _ = built
+    assert mid_surface_area(mesh, n_gauss=5) == pytest.approx(area, rel=1e-4)
+
+
+def test_named_sets_are_the_declared_ones(built):
+    _, deck, mesh, _, _ = built
+    assert set(mesh.sets) == set(deck.geometry.sets()) | {"all"}
+
+
+def test_directors_are_unit_surface_normals(built):
+    name, _, mesh, _, _ = built
+    np.testing.assert_allclose(np.linalg.norm(mesh.director, axis=1), 1.0, atol=1e-12)
+    # The director at each node is normal to the surface tangents of every element there.
+    g = np.einsum("qad,eai->eqdi", shape_derivatives(NODE_RS), mesh.x[mesh.conn])
+    d = mesh.director[mesh.conn]
+    tilt = np.abs(np.einsum("eqdi,eqi->eqd", g, d)) / np.linalg.norm(g, axis=-1)
+    assert tilt.max() < 0.05  # within the interpolation error of the tangents, a few degrees
+
+
+EXACT_NORMALS = {
+    "cylindrical_panel": lambda p: p * [1, 0, 1] / np.hypot(p[:, 0], p[:, 2])[:, None],
+    "tube": lambda p: p * [1, 1, 0] / np.hypot(p[:, 0], p[:, 1])[:, None],
+    "hemisphere": lambda p: p / np.linalg.norm(p, axis=1)[:, None],
+    "rectangle": lambda p: np.tile([0.0, 0.0, 1.0], (len(p), 1)),
+}
+
+
+@pytest.mark.parametrize("name", list(EXACT_NORMALS))
+def test_directors_are_the_exact_outward_normals(name):
+    geometry, mesh_options, _, _ = BUILDERS[name]
+    _, mesh = build(geometry, mesh_options)
+    # gmsh evaluates CAD normals through an inverse parametrisation solved to about 1e-8.
+    np.testing.assert_allclose(mesh.director, EXACT_NORMALS[name](mesh.x), atol=1e-7)
+
+
+def on(mesh, name):
+    return mesh.x[mesh.sets[name].nodes]
+
+
+def test_rectangle_sets_hold_the_right_nodes():
+    _, mesh = build(BUILDERS["rectangle"][0], "divisions = { length = 3, width = 2 }")
+    assert np.allclose(on(mesh, "x0")[:, 0], 0.0) and len(on(mesh, "x0")) == 2 * 2 + 1
+    assert np.allclose(on(mesh, "x1")[:, 0], 2.0) and len(on(mesh, "x1")) == 2 * 2 + 1
+    assert np.allclose(on(mesh, "y0")[:, 1], 0.0) and len(on(mesh, "y0")) == 2 * 3 + 1
+    assert np.allclose(on(mesh, "y1")[:, 1], 1.0) and len(on(mesh, "y1")) == 2 * 3 + 1
+    np.testing.assert_allclose(on(mesh, "x1y1"), [[2.0, 1.0, 0.0]])
+    assert len(mesh.sets["x0"].edges) == 2 and len(mesh.sets["y0"].edges) == 3
+
+
+def test_tube_sets_hold_the_right_nodes():
+    _, mesh = build(BUILDERS["tube_with_cap"][0], "divisions = { around = 4, axial = 3 }")
+    assert np.allclose(on(mesh, "sym_x")[:, 0], 0.0) and np.allclose(on(mesh, "sym_y")[:, 1], 0.0)
+    assert np.allclose(on(mesh, "z0")[:, 2], 0.0) and len(on(mesh, "z0")) == 2 * 4 + 1
+    np.testing.assert_allclose(on(mesh, "pole"), [[0.0, 0.0, 4.0 + RM]], atol=1e-12)
+    np.testing.assert_allclose(on(mesh, "z0_x"), [[RM, 0.0, 0.0]], atol=1e-12)
+    # sym_x runs along the wall (2 x 3 + 1 nodes) and over the cap to the pole (2 arcs of
+    # 2 elements, 2 more nodes each).
+    assert len(on(mesh, "sym_x")) == 2 * 3 + 1 + 2 * 2 * 2
+    assert len(mesh.sets["wall"].elements) == 4 * 3 and len(mesh.sets["cap"].elements) == 3 * 2 * 2
+
+
+def test_plate_with_hole_sets_hold_the_right_nodes():
+    _, mesh = build(BUILDERS["plate_with_hole"][0], "divisions = { around = 1, radial = 1 }")
+    assert mesh.n_elements == 2
+    np.testing.assert_allclose(np.hypot(*on(mesh, "hole")[:, :2].T), 0.025)
+    np.testing.assert_allclose(on(mesh, "A"), [[0.025, 0, 0]], atol=1e-15)
+    np.testing.assert_allclose(on(mesh, "B"), [[0, 0.025, 0]], atol=1e-15)
+    np.testing.assert_allclose(on(mesh, "C"), [[0.05, 0.05, 0]], atol=1e-15)
+
+
+def test_irregular_rectangle_follows_the_given_element_boundaries():
+    """Thesis Figure 4.7, irregular 3-element mesh: straight edges with mid-side nodes at
+    their mid-points and the centre node at the mean of the corners."""
+    _, mesh = build('builder = "rectangle"\nlength = 12.0\nwidth = 1.0',
+                    "divisions = { length = 3, width = 1 }\nboundaries_y0 = [0.0, 0.25, 0.75, 1.0]\n"
+                    "boundaries_y1 = [0.0, 0.3333333333333333, 0.6666666666666666, 1.0]")
+    corners = mesh.x[mesh.conn[:, :4]]
+    bottom = sorted({round(x, 9) for x, y, _ in corners.reshape(-1, 3) if y == 0.0})
+    top = sorted({round(x, 9) for x, y, _ in corners.reshape(-1, 3) if y == 1.0})
+    assert bottom == [0.0, 3.0, 9.0, 12.0] and top == [0.0, 4.0, 8.0, 12.0]
+    xe = mesh.x[mesh.conn]
+    for edge, (a, b) in zip(range(4, 8), [(0, 1), (1, 2), (2, 3), (3, 0)]):
+        np.testing.assert_allclose(xe[:, edge], 0.5 * (xe[:, a] + xe[:, b]), atol=1e-12)
+    np.testing.assert_allclose(xe[:, 8], xe[:, :4].mean(axis=1), atol=1e-12)
+
+
+def test_deck_points_snap_to_nodes_and_off_node_points_are_refused():
+    _, mesh = build(BUILDERS["rectangle"][0], "points = { tip = [2.0, 0.5, 0.0] }")
+    np.testing.assert_allclose(on(mesh, "tip"), [[2.0, 0.5, 0.0]])
+    with pytest.raises(MeshError, match=r"mesh.points.tip: \[2.0, 0.3, 0.0\] is not at a node"):
+        build(BUILDERS["rectangle"][0], "points = { tip = [2.0, 0.3, 0.0] }")
+
+
+def test_gmsh_session_restores_the_sigint_handler_and_finalises_on_error():
+    import gmsh
+
+    def custom(signum, frame):  # pragma: no cover - never called
+        pass
+
+    previous = signal.signal(signal.SIGINT, custom)
+    try:
+        build(BUILDERS["tube"][0], BUILDERS["tube"][1])
+        assert signal.getsignal(signal.SIGINT) is custom
+        with pytest.raises(RuntimeError, match="boom"):
+            with gmsh_session():
+                raise RuntimeError("boom")
+        assert not gmsh.isInitialized()
+        assert signal.getsignal(signal.SIGINT) is custom
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_meshing_works_outside_the_main_thread():
+    """Study workers run tasks in threads; gmsh must not touch signals there."""
+    outcome = {}
+
+    def work():
+        try:
+            outcome["mesh"] = build(BUILDERS["rectangle"][0])[1]
+        except Exception as error:  # reported below
+            outcome["error"] = error
+
+    thread = threading.Thread(target=work)
+    thread.start()
+    thread.join()
+    assert "error" not in outcome, outcome.get("error")
+    assert outcome["mesh"].n_elements == 4
+
+
+def test_mesh_vtu_round_trips_through_file_import(tmp_path):
+    from shellsim.output.mesh_files import write_mesh_vtu
+
+    _, original = build(BUILDERS["tube_with_cap"][0], BUILDERS["tube_with_cap"][1])
+    write_mesh_vtu(original, tmp_path / "mesh.vtu")
+    _, imported = build('builder = "file"\n' f'path = "{tmp_path / "mesh.vtu"}"')
+    np.testing.assert_allclose(imported.x, original.x)
+    np.testing.assert_array_equal(imported.conn, original.conn)
+    np.testing.assert_allclose(imported.director, original.director)
+    for name, named in original.sets.items():
+        assert imported.sets[name].kind == named.kind
+        np.testing.assert_array_equal(imported.sets[name].nodes, named.nodes)
+        if named.kind == "edge":
+            assert {frozenset(e) for e in imported.sets[name].edges.tolist()} == {
+                frozenset(e) for e in named.edges.tolist()}
+
+
+def test_gmsh_msh_file_with_physical_groups_imports_with_its_sets(tmp_path):
+    with gmsh_session() as gmsh:
+        geo = gmsh.model.geo
+        p = [geo.addPoint(x, y, 0) for x, y in ((0, 0), (2, 0), (2, 1), (0, 1))]
+        lines = [geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
+        surface = geo.addPlaneSurface([geo.addCurveLoop(lines)])
+        for line in lines:
+            geo.mesh.setTransfiniteCurve(line, 3)
+        geo.mesh.setTransfiniteSurface(surface)
+        geo.synchronize()
+        gmsh.model.addPhysicalGroup(2, [surface], name="plate")
+        gmsh.model.addPhysicalGroup(1, [lines[3]], name="left")
+        gmsh.model.addPhysicalGroup(0, [p[2]], name="corner")
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(2)
+        gmsh.write(str(tmp_path / "plate.msh"))
+    deck, mesh = build('builder = "file"\npath = "' + str(tmp_path / "plate.msh") + '"',
+                       extra='[[boundary]]\ntype = "clamped"\nset = "left"\n')
+    assert mesh.n_elements == 4 and mesh.sets["plate"].kind == "surface"
+    assert np.allclose(on(mesh, "left")[:, 0], 0.0) and len(mesh.sets["left"].edges) == 2
+    np.testing.assert_allclose(on(mesh, "corner"), [[2.0, 1.0, 0.0]])
+    np.testing.assert_allclose(mesh.director, np.tile([0, 0, 1.0], (mesh.n_nodes, 1)), atol=1e-12)
+
+
+def test_a_file_without_quad9_is_refused_with_what_it_holds(tmp_path):
+    import meshio
+
+    meshio.write(tmp_path / "tri.vtu", meshio.Mesh(np.eye(3), [("triangle", np.array([[0, 1, 2]]))]))
+    from shellsim.deck import parse_deck
+    from shellsim.errors import DeckError
+
+    with pytest.raises(DeckError, match=r"geometry.path: .*no 9-node quadrilaterals \(quad9\); found triangle"):
+        parse_deck(deck_text('builder = "file"\npath = "tri.vtu"'), base_dir=tmp_path)
+
+
+def test_mesh_png_is_not_blank(tmp_path):
+    from PIL import Image
+
+    from shellsim.output.render import render_mesh
+
+    _, mesh = build(BUILDERS["tube_with_cap"][0], BUILDERS["tube_with_cap"][1])
+    render_mesh(mesh, tmp_path / "mesh.png", size=(400, 300))
+    pixels = np.asarray(Image.open(tmp_path / "mesh.png").convert("L"), dtype=float)
+    assert pixels.shape == (300, 400)
+    assert pixels.std() > 20  # a blank (uniform) image has zero spread

@@ -1,0 +1,201 @@
+"""The ``shellsim`` command: parse arguments, call the library, print, set the exit code.
+
+Every user mistake arrives here as a ShellsimError and is printed as a message, never a
+traceback; the exit code is then 2 (1 is kept for a failed reference check).
+"""
+
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from . import __version__
+from .errors import NotYetAvailable, OutputError, ShellsimError
+
+app = typer.Typer(
+    help="Explicit dynamics of thin and thick soft-tissue shells (9-node continuum-based shell).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+out = Console()
+err = Console(stderr=True)
+
+EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+DeckPath = Annotated[Path, typer.Argument(help="Scene deck (TOML).", show_default=False)]
+
+
+def reports_errors(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Turn ShellsimError into a message and exit code 2, Ctrl-C into exit code 130."""
+
+    @functools.wraps(command)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return command(*args, **kwargs)
+        except ShellsimError as error:
+            err.print(f"[bold red]error:[/] {error}", highlight=False, markup=True, soft_wrap=True)
+            raise typer.Exit(EXIT_USER_ERROR) from None
+        except KeyboardInterrupt:
+            err.print("[yellow]interrupted[/]")
+            raise typer.Exit(EXIT_INTERRUPTED) from None
+
+    return wrapper
+
+
+def _version(show: bool) -> None:
+    if show:
+        out.print(f"shellsim {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: Annotated[bool, typer.Option("--version", callback=_version, is_eager=True,
+                                          help="Print the version and exit.")] = False,
+) -> None:
+    """shellsim: validated TOML decks in, time series and pictures out."""
+
+
+@app.command()
+@reports_errors
+def check(deck: DeckPath) -> None:
+    """Validate a deck, build its mesh, and summarise the scene."""
+    from .deck import load_deck
+    from .geometry import build_mesh
+    from .plan import plan
+
+    scene = load_deck(deck)
+    mesh = build_mesh(scene, deck.parent)
+    out.print(_summary(scene, mesh, plan(scene)))
+    if scene.solver.dt_safety_factor < 1.0:
+        err.print(
+            f"[yellow]warning:[/] solver.dt_safety_factor = {scene.solver.dt_safety_factor} < 1 "
+            "puts the time step above the critical step: the run will be unstable"
+        )
+    out.print(f"[green]ok[/] {deck}")
+
+
+@app.command()
+@reports_errors
+def mesh(
+    deck: DeckPath,
+    out_dir: Annotated[Path, typer.Option("--out", help="Folder for mesh.vtu and mesh.png.")] = Path("results"),
+    png: Annotated[bool, typer.Option(help="Also render mesh.png.")] = True,
+) -> None:
+    """Build the scene's geometry with gmsh as 9-node quads: OUT/mesh.vtu and OUT/mesh.png."""
+    from .deck import load_deck
+    from .geometry import build_mesh
+    from .output.mesh_files import write_mesh_vtu
+
+    scene = load_deck(deck)
+    folder = _output_folder(out_dir)
+    built = build_mesh(scene, deck.parent)
+    write_mesh_vtu(built, folder / "mesh.vtu")
+    written = [folder / "mesh.vtu"]
+    if png:
+        from .output.render import render_mesh
+
+        render_mesh(built, folder / "mesh.png")
+        written.append(folder / "mesh.png")
+    sets = ", ".join(f"{name} ({s.kind}, {len(s.nodes)})" for name, s in sorted(built.sets.items()))
+    out.print(f"{scene.meta.title}: {built.n_elements} elements, {built.n_nodes} nodes, "
+              f"{5 * built.n_nodes} DOFs")
+    out.print(f"sets: {sets}", highlight=False)
+    for path in written:
+        out.print(f"wrote {path}")
+
+
+def _not_yet(what: str) -> None:
+    raise NotYetAvailable(f"{what} is not available yet in shellsim {__version__}")
+
+
+@app.command()
+@reports_errors
+def run(deck: DeckPath) -> None:
+    """Integrate a scene in time (explicit central differences)."""
+    _not_yet("'shellsim run' (the explicit solver)")
+
+
+@app.command()
+@reports_errors
+def render(results: Annotated[Path, typer.Argument(help="A run's output folder.")]) -> None:
+    """Render a field of a finished run on the deformed shape (PNG)."""
+    _not_yet("'shellsim render' (renders of run results)")
+
+
+@app.command()
+@reports_errors
+def report(study: Annotated[Path, typer.Argument(help="A study (TOML).")]) -> None:
+    """Error against run time for a study of decks."""
+    _not_yet("'shellsim report' (error-versus-time studies)")
+
+
+@app.command()
+@reports_errors
+def bench() -> None:
+    """Measure speed: microseconds per element per step, GFLOP/s."""
+    _not_yet("'shellsim bench' (solver benchmarks)")
+
+
+def _output_folder(path: Path) -> Path:
+    """Create ``path`` and prove it writable before any work is done."""
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        probe = path / ".shellsim-write-test"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as error:
+        raise OutputError(f"output folder '{path}' is not writable: {error.strerror or error}") from None
+    return path
+
+
+def _summary(scene: Any, built: Any, needs: Any) -> Table:
+    table = Table(title=scene.meta.title, show_header=False, title_justify="left")
+    table.add_column(style="bold")
+    table.add_column()
+    g = scene.geometry
+    params = ", ".join(f"{k}={v}" for k, v in g.model_dump().items() if k != "builder")
+    table.add_row("units", scene.meta.units)
+    if scene.meta.source:
+        table.add_row("source", scene.meta.source)
+    table.add_row("geometry", f"{g.builder} ({params})")
+    divisions = " x ".join(f"{v} {k}" for k, v in scene.mesh.divisions.items())
+    table.add_row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}), "
+                          f"{built.n_nodes} nodes, {5 * built.n_nodes} DOFs")
+    m = scene.material
+    params = ", ".join(f"{k}={v}" for k, v in m.model_dump().items() if k not in ("model", "axes"))
+    table.add_row("material", f"{m.model} ({params})")
+    s = scene.section
+    strain = f"technique {s.technique}" if s.technique else "small strain"
+    table.add_row("section", f"thickness {s.thickness}, {s.points_through_thickness} points through "
+                             f"it, {strain}, {s.formulation} formulation"
+                             + (", plane strain" if s.plane_strain else ""))
+    for bc in scene.boundary:
+        table.add_row("boundary", f"{bc.type} on '{bc.set}'")
+    for load in scene.load:
+        curve = f" x curve '{load.curve}'" if load.curve else ""
+        table.add_row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
+    sv = scene.solver
+    table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
+                            f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
+                            + (f", damping {sv.damping}/s" if sv.damping else ""))
+    for ref in scene.reference:
+        tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
+        table.add_row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "
+                                   f"({ref.measure} of probe '{ref.probe}'; {ref.source})")
+    table.add_row("uses", ", ".join(needs.used()) or "linear small-strain shell only")
+    table.add_row("leaves out", ", ".join(needs.left_out()))
+    return table
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(app())

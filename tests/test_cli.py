@@ -1,0 +1,74 @@
+"""The command line: commands listed, plain errors with exit code 2 and no traceback,
+`check` and `mesh` doing their work."""
+
+from __future__ import annotations
+
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+
+from .conftest import ROOT, deck_text
+
+runner = CliRunner()
+DEFAULT_DECK = ROOT / "decks" / "artery_inflation.toml"
+
+
+def test_help_lists_every_command():
+    result = runner.invoke(app, ["--help"])
+    assert result.exit_code == 0
+    for command in ("run", "mesh", "check", "render", "report", "bench"):
+        assert command in result.output
+
+
+@pytest.mark.parametrize("args", [["run", str(DEFAULT_DECK)], ["render", "results"],
+                                  ["report", "study.toml"], ["bench"]])
+def test_commands_still_to_come_say_so_and_fail(args):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert "not available yet" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_check_summarises_a_valid_deck():
+    result = runner.invoke(app, ["check", str(DEFAULT_DECK)])
+    assert result.exit_code == 0, result.output
+    for fragment in ("tube", "guccione", "19 elements", "technique 1", "anisotropic"):
+        assert fragment in result.output
+
+
+def test_check_of_a_broken_deck_prints_the_problem_without_a_traceback(tmp_path):
+    deck = tmp_path / "broken.toml"
+    deck.write_text(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace("nu = 0.3", "nu = 0.6"))
+    result = runner.invoke(app, ["check", str(deck)])
+    assert result.exit_code == 2
+    assert "material.nu" in result.output and "broken.toml" in result.output
+    assert "Traceback" not in result.output
+
+
+def test_check_warns_about_a_safety_factor_below_one(tmp_path):
+    deck = tmp_path / "unstable.toml"
+    deck.write_text(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0')
+                    .replace("end_time = 1.0", "end_time = 1.0\ndt_safety_factor = 0.8"))
+    result = runner.invoke(app, ["check", str(deck)])
+    assert result.exit_code == 0
+    assert "unstable" in result.output
+
+
+def test_mesh_writes_the_vtu_and_the_png(tmp_path):
+    import meshio
+
+    result = runner.invoke(app, ["mesh", str(DEFAULT_DECK), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    written = meshio.read(tmp_path / "out" / "mesh.vtu")
+    assert written.cells[0].type == "quad9" and len(written.cells[0].data) == 19
+    assert {"director", "thickness", "set_sym_x", "set_pole"} <= set(written.point_data)
+    assert (tmp_path / "out" / "mesh.png").stat().st_size > 1000
+
+
+def test_mesh_into_an_unwritable_place_is_a_clear_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    result = runner.invoke(app, ["mesh", str(DEFAULT_DECK), "--out", str(blocker / "sub")])
+    assert result.exit_code == 2
+    assert "not writable" in result.output

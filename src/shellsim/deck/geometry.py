@@ -13,7 +13,7 @@ from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Field, model_validator
 
-from .types import Positive, Section
+from .types import Positive, Section, tag_of
 
 SetKinds = dict[str, str]
 
@@ -189,7 +189,7 @@ Geometry = Annotated[
 
 #: builder name -> model class, for defaults and messages.
 BUILDERS = {
-    cls.model_fields["builder"].annotation.__args__[0]: cls
+    tag_of(cls)[1]: cls
     for cls in (
         Rectangle, CylindricalPanel, TwistedStrip, AnnularSector, PlateWithHole, Tube,
         Hemisphere, MeshFile,

@@ -12,7 +12,7 @@ from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Field, field_validator, model_validator
 
-from .types import Positive, Real, Section, Vec3
+from .types import Positive, Real, Section, Vec3, tag_of
 
 
 class CylindricalAxes(Section):
@@ -115,7 +115,7 @@ Material = Annotated[
 ]
 
 MATERIALS = {
-    cls.model_fields["model"].annotation.__args__[0]: cls
+    tag_of(cls)[1]: cls
     for cls in (LinearElastic, NeoHookean, MooneyRivlin, Guccione)
 }
 

@@ -12,6 +12,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from .references import did_you_mean
+from .types import tag_of
 
 #: Keys users bring from other codes, with why shellsim does not take them.
 HINTS = {
@@ -168,11 +169,9 @@ def _pick_member(annotation: Any, node: Any) -> Any:
             members = [a for a in args if a is not type(None)]
             if isinstance(node, dict):
                 for m in members:
-                    if isinstance(m, type) and issubclass(m, BaseModel):
-                        tag_field = next(iter(m.model_fields))
-                        tag = typing.get_args(m.model_fields[tag_field].annotation)
-                        if tag and node.get(tag_field) in tag:
-                            return m
+                    tag = tag_of(m) if isinstance(m, type) and issubclass(m, BaseModel) else None
+                    if tag and node.get(tag[0]) == tag[1]:
+                        return m
             models = [m for m in members if isinstance(m, type) and issubclass(m, BaseModel)]
             return models[0] if len(models) == 1 else None
         else:

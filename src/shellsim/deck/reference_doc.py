@@ -13,6 +13,7 @@ from . import schema
 from .curves import Curve
 from .geometry import BUILDERS
 from .material import MATERIALS, CylindricalAxes, FixedAxes
+from .types import tag_of
 
 INTRO = """# Deck reference
 
@@ -26,8 +27,7 @@ This page is generated from the deck models (`python -m shellsim.deck.reference_
 
 def _tag(cls: type[BaseModel]) -> str:
     """The discriminating value of a union member (builder, model, type, kind)."""
-    first = next(iter(cls.model_fields.values()))
-    return first.annotation.__args__[0]
+    return tag_of(cls)[1]
 
 
 def _default(field) -> str:
@@ -39,7 +39,8 @@ def _default(field) -> str:
 
 def _table(cls: type[BaseModel], heading: str, skip_tag: bool = False) -> list[str]:
     rows = [f"{heading}", "", inspect.cleandoc(cls.__doc__ or ""), "", "| key | default |", "|---|---|"]
-    names = list(cls.model_fields)[1 if skip_tag else 0:]
+    tag = tag_of(cls)
+    names = [n for n in cls.model_fields if not (skip_tag and tag and n == tag[0])]
     rows += [f"| `{name}` | {_default(cls.model_fields[name])} |" for name in names]
     return rows + [""]
 

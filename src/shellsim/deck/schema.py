@@ -144,13 +144,18 @@ class Pressure(Section):
     follower: bool = True
 
 
-class EdgeForce(Section):
-    """Force per unit (initial) length along an edge set, global components."""
+class VectorLoad(Section):
+    """A load with global vector components, ``value * curve(t)``."""
 
-    type: Literal["edge_force"]
     set: Name
     value: Vec3
     curve: Name | None = None
+
+
+class EdgeForce(VectorLoad):
+    """Force per unit (initial) length along an edge set, global components."""
+
+    type: Literal["edge_force"]
 
 
 class EdgePressure(Section):
@@ -164,41 +169,30 @@ class EdgePressure(Section):
     curve: Name | None = None
 
 
-class EdgeMoment(Section):
+class EdgeMoment(VectorLoad):
     """Moment per unit (initial) length along an edge set, global components."""
 
     type: Literal["edge_moment"]
-    set: Name
-    value: Vec3
-    curve: Name | None = None
 
 
-class PointForce(Section):
+class PointForce(VectorLoad):
     """Force on every node of a set, global components."""
 
     type: Literal["point_force"]
-    set: Name
-    value: Vec3
-    curve: Name | None = None
 
 
-class PointMoment(Section):
+class PointMoment(VectorLoad):
     """Moment on every node of a set, global components."""
 
     type: Literal["point_moment"]
-    set: Name
-    value: Vec3
-    curve: Name | None = None
 
 
-class BodyForce(Section):
+class BodyForce(VectorLoad):
     """Force per unit (initial) volume on a surface set, global components (self-weight is
     density times gravity)."""
 
     type: Literal["body_force"]
     set: Name = "all"
-    value: Vec3
-    curve: Name | None = None
 
 
 Load = Annotated[

@@ -3,6 +3,7 @@ string where a number belongs is a mistake, not something to coerce) and names."
 
 from __future__ import annotations
 
+import typing
 from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -20,3 +21,18 @@ class Section(BaseModel):
     """Base of every deck table: unknown keys are errors, values are immutable."""
 
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+#: Keys that choose the member of a union table (builder, material model, load type, ...).
+DISCRIMINATORS = ("builder", "model", "type", "kind")
+
+
+def tag_of(cls: type[BaseModel]) -> tuple[str, str] | None:
+    """(key, value) that selects ``cls`` in its union, e.g. ("builder", "tube"), or None."""
+    for key in DISCRIMINATORS:
+        field = cls.model_fields.get(key)
+        if field is not None:
+            args = typing.get_args(field.annotation)
+            if len(args) == 1 and isinstance(args[0], str):
+                return key, args[0]
+    return None

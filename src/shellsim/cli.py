@@ -118,11 +118,73 @@ def _not_yet(what: str) -> None:
     raise NotYetAvailable(f"{what} is not available yet in shellsim {__version__}")
 
 
+EXIT_REFERENCE_FAILED = 1
+EXIT_UNSTABLE = 3
+
+
 @app.command()
 @reports_errors
-def run(deck: DeckPath) -> None:
-    """Integrate a scene in time (explicit central differences)."""
-    _not_yet("'shellsim run' (the explicit solver)")
+def run(
+    deck: DeckPath,
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Output folder [default: results/DECK-NAME].")] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
+) -> None:
+    """Integrate a scene in time (explicit central differences): OUT/summary.json and
+    OUT/history.csv. Exit code 1 when a reference check fails, 3 when the run goes unstable."""
+    from .deck import load_deck
+    from .errors import NumericalError
+    from .geometry import build_mesh
+    from .model import build_model
+    from .output.history import HistoryWriter
+    from .output.progress import ProgressDisplay
+    from .output.summary import summary, write_json
+    from .plan import plan
+    from .solver.run import Listeners, integrate, prepare
+
+    scene = load_deck(deck)
+    folder = _output_folder(out_dir or Path("results") / deck.stem)
+    mesh_ = build_mesh(scene, deck.parent)
+    current = prepare(scene, mesh_, build_model(scene, mesh_))
+    history = HistoryWriter(folder / "history.csv")
+    progress = ProgressDisplay(out, scene.solver.end_time, quiet)
+    message = None
+    try:
+        integrate(current, Listeners(history, progress))
+    except NumericalError as error:
+        message = str(error)
+    except KeyboardInterrupt:
+        message = "interrupted by the user"
+    finally:
+        progress.close()
+        history.close()
+        result = summary(current, deck, plan(scene), message)
+        write_json(result, folder / "summary.json")
+    if current.status == "interrupted":
+        raise KeyboardInterrupt
+    if not quiet:
+        out.print(_run_report(result, folder))
+    if current.status == "unstable":
+        err.print(f"[bold red]error:[/] {message}", highlight=False)
+        raise typer.Exit(EXIT_UNSTABLE)
+    if not all(r["passed"] for r in result["reference"]):
+        raise typer.Exit(EXIT_REFERENCE_FAILED)
+
+
+def _run_report(result: dict, folder: Path) -> Table:
+    table = Table(title=f"{result['title']}: {result['status']}", title_justify="left")
+    for column in ("quantity", "computed", "expected", "error", "tolerance", "ok"):
+        table.add_column(column)
+    for r in result["reference"]:
+        tolerance = f"{r['tolerance_percent']}%" if r.get("tolerance") is None else f"{r['tolerance']}"
+        error = "-" if r["computed"] is None else (
+            f"{r['error_percent']:+.3f}%" if r.get("error_percent") is not None else f"{r['error']:+.4g}")
+        table.add_row(r["quantity"], "-" if r["computed"] is None else f"{r['computed']:.6g}",
+                      f"{r['expected']:.6g}", error, tolerance, "[green]yes" if r["passed"] else "[red]no")
+    e = result["energy"]
+    table.caption = (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
+                     f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
+                     f"{e['balance_error_percent']:+.3f}%; results in {folder}")
+    return table
 
 
 @app.command()

@@ -34,5 +34,9 @@ class OutputError(ShellsimError):
     """Results that cannot be written (unwritable directory, disk full)."""
 
 
+class NumericalError(ShellsimError):
+    """A run that went unstable (NaN, energy blow-up); what it wrote so far is kept."""
+
+
 class NotYetAvailable(ShellsimError):
     """A command whose work is planned but not built yet."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
+from numba import njit
 from pydantic import field_validator, model_validator
 
 from .types import Real, Section
@@ -50,24 +51,37 @@ class Curve(Section):
 
     def __call__(self, time: float | np.ndarray) -> float | np.ndarray:
         """Factor at ``time`` (scalar or array, same shape back)."""
-        t = np.asarray(self.t)
-        v = np.asarray(self.value)
+        table = self.table()
         x = np.asarray(time, dtype=float)
-        if len(t) == 1:
-            return np.full_like(x, v[0]) if x.ndim else float(v[0])
-        i = np.clip(np.searchsorted(t, x, side="right") - 1, 0, len(t) - 2)
-        u = (x - t[i]) / (t[i + 1] - t[i])
-        inside = (x >= t[0]) & (x <= t[-1])
-        if self.interpolate == "step":
-            out = np.where(x >= t[i + 1], v[i + 1], v[i])
-        else:
-            w = np.clip(u, 0.0, 1.0)
-            if self.interpolate == "smooth":
-                w = w * w * (3.0 - 2.0 * w)
-            out = v[i] + w * (v[i + 1] - v[i])
-        if self.extrapolate == "linear":
-            linear = v[i] + u * (v[i + 1] - v[i])
-            out = np.where(inside, out, linear)
-        else:
-            out = np.where(x < t[0], v[0], np.where(x > t[-1], v[-1], out))
+        out = np.array([curve_value(*table, float(ti)) for ti in x.ravel()]).reshape(x.shape)
         return out if x.ndim else float(out)
+
+    def table(self) -> tuple[np.ndarray, np.ndarray, int, int]:
+        """(times, values, interpolation code, extrapolation code) for :func:`curve_value`."""
+        return (np.asarray(self.t, dtype=float), np.asarray(self.value, dtype=float),
+                INTERPOLATION[self.interpolate], EXTRAPOLATION[self.extrapolate])
+
+
+INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2}
+EXTRAPOLATION = {"constant": 0, "linear": 1}
+
+
+@njit(cache=True)
+def curve_value(t: np.ndarray, v: np.ndarray, interpolate: int, extrapolate: int, time: float) -> float:
+    """A curve's factor at ``time``; codes as in INTERPOLATION and EXTRAPOLATION. Used by
+    :class:`Curve` and inside the compiled time loop alike."""
+    n = t.shape[0]
+    if n == 1:
+        return v[0]
+    if time <= t[0] or time >= t[n - 1]:
+        i = 0 if time <= t[0] else n - 2
+        if extrapolate == 1:
+            return v[i] + (time - t[i]) / (t[i + 1] - t[i]) * (v[i + 1] - v[i])
+        return v[0] if time <= t[0] else v[n - 1]
+    i = np.searchsorted(t, time, side="right") - 1
+    u = (time - t[i]) / (t[i + 1] - t[i])
+    if interpolate == 1:
+        return v[i]
+    if interpolate == 2:
+        u = u * u * (3.0 - 2.0 * u)
+    return v[i] + u * (v[i + 1] - v[i])

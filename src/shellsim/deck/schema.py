@@ -132,15 +132,18 @@ Boundary = Annotated[Union[Clamped, Fixed, Symmetry, Prescribed], Field(discrimi
 
 
 class Pressure(Section):
-    """Pressure ``value * curve(t)`` on a surface set. Positive pressure pushes along the
-    director (it inflates a tube whose directors point outward). ``follower``: acts normal
-    to the current surface on its current area (thesis 3.12.1); otherwise a dead load along
-    the initial normal on the initial area."""
+    """Pressure ``value * curve(t)`` on one face of a surface set: ``bottom`` (t = -1, the
+    side the directors point away from), ``top`` (t = +1) or the ``mid`` surface. Positive
+    pressure pushes into the shell: along the directors on the bottom face and the
+    mid-surface (it inflates a tube whose directors point outward), against them on the top
+    face. ``follower``: acts normal to the current face on its current area (thesis
+    3.12.1); otherwise a dead load along the initial normal on the initial area."""
 
     type: Literal["pressure"]
     set: Name = "all"
     value: Real
     curve: Name | None = None
+    face: Literal["bottom", "mid", "top"] = "mid"
     follower: bool = True
 
 

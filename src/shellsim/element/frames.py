@@ -1,0 +1,100 @@
+"""Lamina and fibre coordinate systems and the director update (thesis 2.5.1.2, 3.2, 3.3).
+
+All functions are compiled with numba and work on one point or one node, so the element
+kernels can call them in their loops.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    """out = a x b, all (3,)."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(cache=True, inline="always")
+def normalize(a: np.ndarray) -> None:
+    """Scale a (3,) to unit length in place."""
+    n = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    a[0] /= n
+    a[1] /= n
+    a[2] /= n
+
+
+@njit(cache=True)
+def lamina_frame(g_r: np.ndarray, g_s: np.ndarray, q: np.ndarray) -> None:
+    """Hughes' lamina basis at a point from the tangents g_r = dy/dr, g_s = dy/ds (3,).
+
+    e3 is the lamina normal; e1, e2 lie in the lamina, symmetric about the bisector of
+    e_r and e_s (thesis Eq 2.57 and Figure 2.11). Writes q (3, 3) with rows e1, e2, e3
+    (the global -> lamina rotation [q]).
+    """
+    er = g_r / np.sqrt(g_r @ g_r)
+    es = g_s / np.sqrt(g_s @ g_s)
+    e3 = np.empty(3)
+    cross(er, es, e3)
+    normalize(e3)
+    ea = er + es
+    normalize(ea)
+    eb = np.empty(3)
+    cross(e3, ea, eb)
+    normalize(eb)
+    c = np.sqrt(0.5)
+    for i in range(3):
+        q[0, i] = c * (ea[i] - eb[i])
+        q[1, i] = c * (ea[i] + eb[i])
+        q[2, i] = e3[i]
+
+
+@njit(cache=True)
+def initial_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
+    """Hughes' fibre basis for a director d (3,): writes e1f into e1 (3,); e2f = d x e1f.
+
+    Steps 1-7 of thesis 2.5.1.2.3: the global axis least aligned with the director is
+    crossed with it, so a director near e3 gets e1f, e2f near e1, e2.
+    """
+    b1, b2, b3 = abs(d[0]), abs(d[1]), abs(d[2])
+    j = 0
+    if b1 > b3:
+        b3 = b1
+        j = 1
+    if b2 > b3:
+        j = 2
+    axis = np.zeros(3)
+    axis[j] = 1.0
+    e2 = np.empty(3)
+    cross(d, axis, e2)
+    normalize(e2)
+    cross(e2, d, e1)
+
+
+@njit(cache=True)
+def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
+    """The thesis' new fibre-frame update (3.3.2): e2f = d x e1f(previous), e1f = e2f x d.
+
+    Crossing with the previous step's e1f instead of a fixed global axis keeps the frame's
+    sense through any rotation (bending past 90 degrees no longer flips it). e1 (3,) is
+    updated in place.
+    """
+    e2 = np.empty(3)
+    cross(d, e1, e2)
+    normalize(e2)
+    cross(e2, d, e1)
+
+
+@njit(cache=True)
+def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: float) -> None:
+    """Director update by trial increment and normalisation (thesis 3.2, Eq 2.62):
+    d <- (d - dtheta1 e1f - dtheta2 e2f) / |...|, then the fibre frame follows. In place."""
+    e2 = np.empty(3)
+    cross(d, e1, e2)
+    for i in range(3):
+        d[i] -= dtheta1 * e1[i] + dtheta2 * e2[i]
+    normalize(d)
+    update_fibre_frame(d, e1)

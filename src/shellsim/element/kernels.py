@@ -1,0 +1,450 @@
+"""Element kernels of the 9-node continuum-based shell, compiled with numba.
+
+Kinematics (thesis Eq 3.3): y(r, s, t) = sum_a N_a (x_a + t h_a/2 d_a), with mid-surface
+nodes x_a, unit directors d_a and fibre lengths h_a. A director moves by
+delta d_a = -theta1 e1f_a - theta2 e2f_a (thesis Eq 2.62), so each node has 5 DOF.
+
+Strain-displacement, done once and consistently instead of copying Eqs 3.18-3.19 (whose
+rotation columns swap e1f and e2f between the two equations): at an integration point, a
+virtual field changes the displacement gradient by
+
+    delta L = sum_a delta u_a (x) gN_a + delta d_a (x) gM_a,
+    gN_a = J^-T (dN_a/dr, dN_a/ds, 0),  gM_a = h_a/2 J^-T (t dN_a/dr, t dN_a/ds, N_a),
+
+J = dy/d(r, s, t) the current Jacobian (columns). The lamina strains of Eq 3.20 are the
+components of sym(q delta L q^T), q the lamina frame; the thesis' B~_L^l is exactly this
+map. So B^T sigma needs no B: with sigma_g = q^T sigma^l q (global Cauchy stress),
+f_a = sigma_g gN_a dv (translations) and g_a = sigma_g gM_a dv (conjugate to the director),
+whose rotational components are -e1f.g_a and -e2f.g_a. The same two helpers give the
+material stiffness product K v of Eq 3.37 (strain from v, stress by C~, force).
+
+Integration: n_q in-plane Gauss points (3 x 3) times n_t through the thickness.
+Array layout: element axis first; (ne, n_q, n_t, ...) for point data.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .frames import lamina_frame
+
+
+@njit(cache=True)
+def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
+    """Current Jacobian, its inverse, lamina frame and the gradient vectors at one point.
+
+    xe, de (9, 3); he (9,); N, dNr, dNs (9,) at the point; t the thickness coordinate.
+    Writes jac, jinv, q (3, 3) and gN, gM (9, 3). Returns det J.
+    """
+    for i in range(3):
+        jac[i, 0] = 0.0
+        jac[i, 1] = 0.0
+        jac[i, 2] = 0.0
+    for a in range(9):
+        half = 0.5 * he[a]
+        for i in range(3):
+            pos = xe[a, i] + t * half * de[a, i]
+            jac[i, 0] += dNr[a] * pos
+            jac[i, 1] += dNs[a] * pos
+            jac[i, 2] += N[a] * half * de[a, i]
+    det = (jac[0, 0] * (jac[1, 1] * jac[2, 2] - jac[1, 2] * jac[2, 1])
+           - jac[0, 1] * (jac[1, 0] * jac[2, 2] - jac[1, 2] * jac[2, 0])
+           + jac[0, 2] * (jac[1, 0] * jac[2, 1] - jac[1, 1] * jac[2, 0]))
+    jinv[0, 0] = (jac[1, 1] * jac[2, 2] - jac[1, 2] * jac[2, 1]) / det
+    jinv[0, 1] = (jac[0, 2] * jac[2, 1] - jac[0, 1] * jac[2, 2]) / det
+    jinv[0, 2] = (jac[0, 1] * jac[1, 2] - jac[0, 2] * jac[1, 1]) / det
+    jinv[1, 0] = (jac[1, 2] * jac[2, 0] - jac[1, 0] * jac[2, 2]) / det
+    jinv[1, 1] = (jac[0, 0] * jac[2, 2] - jac[0, 2] * jac[2, 0]) / det
+    jinv[1, 2] = (jac[0, 2] * jac[1, 0] - jac[0, 0] * jac[1, 2]) / det
+    jinv[2, 0] = (jac[1, 0] * jac[2, 1] - jac[1, 1] * jac[2, 0]) / det
+    jinv[2, 1] = (jac[0, 1] * jac[2, 0] - jac[0, 0] * jac[2, 1]) / det
+    jinv[2, 2] = (jac[0, 0] * jac[1, 1] - jac[0, 1] * jac[1, 0]) / det
+    lamina_frame(jac[:, 0].copy(), jac[:, 1].copy(), q)
+    for a in range(9):
+        half = 0.5 * he[a]
+        for j in range(3):
+            gN[a, j] = jinv[0, j] * dNr[a] + jinv[1, j] * dNs[a]
+            gM[a, j] = half * (t * gN[a, j] + jinv[2, j] * N[a])
+    return det
+
+
+@njit(cache=True)
+def _lamina_to_global(s5, q, sg):
+    """Global stress sg (3, 3) = q^T sigma^l q from lamina (s11, s22, s12, s13, s23)."""
+    sl = np.empty((3, 3))
+    sl[0, 0] = s5[0]
+    sl[1, 1] = s5[1]
+    sl[2, 2] = 0.0
+    sl[0, 1] = sl[1, 0] = s5[2]
+    sl[0, 2] = sl[2, 0] = s5[3]
+    sl[1, 2] = sl[2, 1] = s5[4]
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                for m in range(3):
+                    acc += q[k, i] * sl[k, m] * q[m, j]
+            sg[i, j] = acc
+
+
+@njit(cache=True)
+def _global_to_lamina_strain(eg, q, e5):
+    """Lamina strain vector (e11, e22, 2e12, 2e13, 2e23) of q eg q^T, eg (3, 3) symmetric."""
+    el = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                for m in range(3):
+                    acc += q[i, k] * eg[k, m] * q[j, m]
+            el[i, j] = acc
+    e5[0] = el[0, 0]
+    e5[1] = el[1, 1]
+    e5[2] = 2.0 * el[0, 1]
+    e5[3] = 2.0 * el[0, 2]
+    e5[4] = 2.0 * el[1, 2]
+
+
+@njit(cache=True)
+def _accumulate(sg, gN, gM, dv, fe, ge):
+    """fe[a] += sg gN[a] dv, ge[a] += sg gM[a] dv, for the 9 nodes."""
+    for a in range(9):
+        for i in range(3):
+            fe[a, i] += (sg[i, 0] * gN[a, 0] + sg[i, 1] * gN[a, 1] + sg[i, 2] * gN[a, 2]) * dv
+            ge[a, i] += (sg[i, 0] * gM[a, 0] + sg[i, 1] * gM[a, 1] + sg[i, 2] * gM[a, 2]) * dv
+
+
+@njit(cache=True)
+def _gradient_of(ue, ve, gN, gM, L):
+    """L (3, 3) = sum_a ue[a] (x) gN[a] + ve[a] (x) gM[a]."""
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for a in range(9):
+                acc += ue[a, i] * gN[a, j] + ve[a, i] * gM[a, j]
+            L[i, j] = acc
+
+
+@njit(cache=True)
+def _to_rotational(g, d, e1, out):
+    """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
+    (-e1f.g, -e2f.g), e2f = d x e1f."""
+    for n in range(g.shape[0]):
+        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
+        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
+        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
+        out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
+
+
+@njit(cache=True)
+def director_increments(w, d, e1, out):
+    """Director increments (n, 3) of rotational DOF values w (n, 2): -w1 e1f - w2 e2f."""
+    for n in range(w.shape[0]):
+        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
+        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
+        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        out[n, 0] = -w[n, 0] * e1[n, 0] - w[n, 1] * e2x
+        out[n, 1] = -w[n, 0] * e1[n, 1] - w[n, 1] * e2y
+        out[n, 2] = -w[n, 0] * e1[n, 2] - w[n, 1] * e2z
+
+
+@njit(cache=True)
+def internal_forces(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, jac0_inv, C,
+                    incremental, dx, dd, stress, f, fr):
+    """Internal forces of all elements at the current configuration.
+
+    Parameters
+    ----------
+    x, d : (n, 3) current mid-surface positions and unit directors.
+    h : (n,) fibre lengths. e1 : (n, 3) fibre-frame first axes.
+    conn : (ne, 9). N, dNr, dNs : (nq, 9) shape functions and derivatives at the
+        in-plane points; wq (nq,). tz, wt : (nt,) thickness points and weights.
+    jac0_inv : (ne, nq, nt, 3, 3) inverse reference Jacobians (total formulation).
+    C : (5, 5) reduced lamina constitutive matrix.
+    incremental : False for the total formulation (stress from the total deformation,
+        Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
+        in the lamina frame plus C~ times the strain increment of the last step, Eq 3.2).
+    dx, dd : (n, 3) last step's mid-surface and director increments (incremental only).
+    stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
+    f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
+    """
+    nn = x.shape[0]
+    f[:] = 0.0
+    g = np.zeros((nn, 3))
+    jac = np.empty((3, 3))
+    jinv = np.empty((3, 3))
+    q = np.empty((3, 3))
+    gN = np.empty((9, 3))
+    gM = np.empty((9, 3))
+    sg = np.empty((3, 3))
+    L = np.empty((3, 3))
+    eg = np.empty((3, 3))
+    e5 = np.empty(5)
+    xe = np.empty((9, 3))
+    de = np.empty((9, 3))
+    he = np.empty(9)
+    ue = np.empty((9, 3))
+    ve = np.empty((9, 3))
+    fe = np.empty((9, 3))
+    ge = np.empty((9, 3))
+    for e in range(conn.shape[0]):
+        for a in range(9):
+            node = conn[e, a]
+            he[a] = h[node]
+            for i in range(3):
+                xe[a, i] = x[node, i]
+                de[a, i] = d[node, i]
+                ue[a, i] = dx[node, i]
+                ve[a, i] = dd[node, i]
+        fe[:] = 0.0
+        ge[:] = 0.0
+        for p in range(N.shape[0]):
+            for k in range(tz.shape[0]):
+                det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
+                if incremental:
+                    _gradient_of(ue, ve, gN, gM, L)
+                    for i in range(3):
+                        for j in range(3):
+                            eg[i, j] = 0.5 * (L[i, j] + L[j, i])
+                    _global_to_lamina_strain(eg, q, e5)
+                    for i in range(5):
+                        acc = 0.0
+                        for j in range(5):
+                            acc += C[i, j] * e5[j]
+                        stress[e, p, k, i] += acc
+                else:
+                    # F = J J0^-1; Almansi strain 1/2 (I - (F F^T)^-1) = 1/2 (I - F^-T F^-1),
+                    # with F^-1 = J0 J^-1: G = F^-1, eg = 1/2 (I - G^T G).
+                    j0i = jac0_inv[e, p, k]
+                    for i in range(3):
+                        for j in range(3):
+                            acc = 0.0
+                            for m in range(3):
+                                acc += jac[i, m] * j0i[m, j]
+                            L[i, j] = acc  # F
+                    _almansi(L, eg)
+                    _global_to_lamina_strain(eg, q, e5)
+                    for i in range(5):
+                        acc = 0.0
+                        for j in range(5):
+                            acc += C[i, j] * e5[j]
+                        stress[e, p, k, i] = acc
+                _lamina_to_global(stress[e, p, k], q, sg)
+                _accumulate(sg, gN, gM, det * wq[p] * wt[k], fe, ge)
+        for a in range(9):
+            node = conn[e, a]
+            for i in range(3):
+                f[node, i] += fe[a, i]
+                g[node, i] += ge[a, i]
+    _to_rotational(g, d, e1, fr)
+
+
+@njit(cache=True)
+def _almansi(F, eg):
+    """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3)."""
+    B = F @ F.T
+    Bi = np.linalg.inv(B)
+    for i in range(3):
+        for j in range(3):
+            eg[i, j] = -0.5 * Bi[i, j]
+        eg[i, i] += 0.5
+
+
+@njit(cache=True)
+def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, C, vu, vr, f, fr):
+    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
+
+    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
+    fr (n, 2). Other arguments as :func:`internal_forces`.
+    """
+    nn = x.shape[0]
+    vd = np.empty((nn, 3))
+    director_increments(vr, d, e1, vd)
+    f[:] = 0.0
+    g = np.zeros((nn, 3))
+    jac = np.empty((3, 3))
+    jinv = np.empty((3, 3))
+    q = np.empty((3, 3))
+    gN = np.empty((9, 3))
+    gM = np.empty((9, 3))
+    sg = np.empty((3, 3))
+    L = np.empty((3, 3))
+    eg = np.empty((3, 3))
+    e5 = np.empty(5)
+    s5 = np.empty(5)
+    xe = np.empty((9, 3))
+    de = np.empty((9, 3))
+    he = np.empty(9)
+    ue = np.empty((9, 3))
+    ve = np.empty((9, 3))
+    fe = np.empty((9, 3))
+    ge = np.empty((9, 3))
+    for e in range(conn.shape[0]):
+        for a in range(9):
+            node = conn[e, a]
+            he[a] = h[node]
+            for i in range(3):
+                xe[a, i] = x[node, i]
+                de[a, i] = d[node, i]
+                ue[a, i] = vu[node, i]
+                ve[a, i] = vd[node, i]
+        fe[:] = 0.0
+        ge[:] = 0.0
+        for p in range(N.shape[0]):
+            for k in range(tz.shape[0]):
+                det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
+                _gradient_of(ue, ve, gN, gM, L)
+                for i in range(3):
+                    for j in range(3):
+                        eg[i, j] = 0.5 * (L[i, j] + L[j, i])
+                _global_to_lamina_strain(eg, q, e5)
+                for i in range(5):
+                    acc = 0.0
+                    for j in range(5):
+                        acc += C[i, j] * e5[j]
+                    s5[i] = acc
+                _lamina_to_global(s5, q, sg)
+                _accumulate(sg, gN, gM, det * wq[p] * wt[k], fe, ge)
+        for a in range(9):
+            node = conn[e, a]
+            for i in range(3):
+                f[node, i] += fe[a, i]
+                g[node, i] += ge[a, i]
+    _to_rotational(g, d, e1, fr)
+
+
+@njit(cache=True)
+def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, mr):
+    """Lumped nodal masses on the current configuration (thesis 3.14).
+
+    hughes=True gives M1 (Hughes et al. 1981): translational masses proportional to
+    int N_a^2 rho dV, scaled to the element mass; rotational ones are those times
+    max(h_a^2/12, A/8). hughes=False gives M2: row sums of the consistent mass, separately
+    for the translational block (int N_a rho dV) and the director block
+    (sum_b int rho N_a N_b t^2 h_a h_b / 4 dV). Writes mt (n,) and mr (n,).
+    """
+    mt[:] = 0.0
+    mr[:] = 0.0
+    jac = np.empty((3, 3))
+    jinv = np.empty((3, 3))
+    q = np.empty((3, 3))
+    gN = np.empty((9, 3))
+    gM = np.empty((9, 3))
+    xe = np.empty((9, 3))
+    de = np.empty((9, 3))
+    he = np.empty(9)
+    raw = np.empty(9)
+    rot = np.empty(9)
+    for e in range(conn.shape[0]):
+        for a in range(9):
+            node = conn[e, a]
+            he[a] = h[node]
+            for i in range(3):
+                xe[a, i] = x[node, i]
+                de[a, i] = d[node, i]
+        raw[:] = 0.0
+        rot[:] = 0.0
+        volume = 0.0
+        for p in range(N.shape[0]):
+            for k in range(tz.shape[0]):
+                det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
+                dv = det * wq[p] * wt[k]
+                volume += dv
+                if hughes:
+                    for a in range(9):
+                        raw[a] += N[p, a] * N[p, a] * density * dv
+                else:
+                    hbar = 0.0
+                    for b in range(9):
+                        hbar += N[p, b] * he[b]
+                    for a in range(9):
+                        raw[a] += N[p, a] * density * dv
+                        rot[a] += N[p, a] * density * dv * tz[k] * tz[k] * he[a] * hbar / 4.0
+        if hughes:
+            total = raw.sum()
+            h_avg = he.mean()
+            area = volume / h_avg
+            for a in range(9):
+                m = density * volume * raw[a] / total
+                rot[a] = m * max(he[a] * he[a] / 12.0, area / 8.0)
+                raw[a] = m
+        for a in range(9):
+            mt[conn[e, a]] += raw[a]
+            mr[conn[e, a]] += rot[a]
+
+
+@njit(cache=True)
+def pressure_forces(x, d, h, conn, elements, face, scale, N, dNr, dNs, wq, f, g):
+    """Follower pressure on faces of ``elements`` (m,), thesis 3.12.1: adds to f, g (n, 3).
+
+    face (m,): -1 bottom (t = -1), 0 mid-surface, +1 top. scale (m,): the current pressure;
+    positive pushes into the shell, i.e. along +n on the bottom face and the mid-surface
+    and along -n on the top face, n = g_r x g_s / |.| (the directors' side). Forces act
+    where the face is, so the director-conjugate part g carries their lever arm.
+    """
+    yr = np.empty(3)
+    ys = np.empty(3)
+    area = np.empty(3)
+    for m in range(elements.shape[0]):
+        e = elements[m]
+        t = float(face[m])
+        sign = -1.0 if face[m] > 0 else 1.0
+        for p in range(N.shape[0]):
+            yr[:] = 0.0
+            ys[:] = 0.0
+            for a in range(9):
+                node = conn[e, a]
+                for i in range(3):
+                    pos = x[node, i] + t * 0.5 * h[node] * d[node, i]
+                    yr[i] += dNr[p, a] * pos
+                    ys[i] += dNs[p, a] * pos
+            area[0] = yr[1] * ys[2] - yr[2] * ys[1]
+            area[1] = yr[2] * ys[0] - yr[0] * ys[2]
+            area[2] = yr[0] * ys[1] - yr[1] * ys[0]
+            for a in range(9):
+                node = conn[e, a]
+                w = sign * scale[m] * N[p, a] * wq[p]
+                for i in range(3):
+                    f[node, i] += w * area[i]
+                    g[node, i] += w * area[i] * t * 0.5 * h[node]
+
+
+#: 3-point Gauss rule along an element edge and the 1D quadratic shape functions at its
+#: points, for (corner, mid-side, corner) node triples.
+EDGE_XI = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
+EDGE_W = np.array([5.0, 8.0, 5.0]) / 9.0
+EDGE_N = np.stack([EDGE_XI * (EDGE_XI - 1) / 2, 1 - EDGE_XI**2, EDGE_XI * (EDGE_XI + 1) / 2], axis=1)
+EDGE_DN = np.stack([EDGE_XI - 0.5, -2 * EDGE_XI, EDGE_XI + 0.5], axis=1)
+
+
+@njit(cache=True)
+def edge_pressure_forces(x, d, h, edges, outward, scale, f):
+    """Pressure on the shell's edge faces (force per unit edge length = p times the fibre
+    length), normal to the edge within the shell, pushing in. Adds to f (n, 3).
+
+    edges (m, 3) node triples; outward (m,) +1 or -1, the sign that makes
+    tangent x director point out of the shell; scale (m,) the current pressure.
+    """
+    for m in range(edges.shape[0]):
+        for p in range(3):
+            tan = np.zeros(3)
+            nrm = np.zeros(3)
+            thick = 0.0
+            for k in range(3):
+                node = edges[m, k]
+                thick += EDGE_N[p, k] * h[node]
+                for i in range(3):
+                    tan[i] += EDGE_DN[p, k] * x[node, i]
+                    nrm[i] += EDGE_N[p, k] * d[node, i]
+            nrm /= np.sqrt(nrm @ nrm)
+            out = np.empty(3)
+            out[0] = tan[1] * nrm[2] - tan[2] * nrm[1]
+            out[1] = tan[2] * nrm[0] - tan[0] * nrm[2]
+            out[2] = tan[0] * nrm[1] - tan[1] * nrm[0]
+            for k in range(3):
+                node = edges[m, k]
+                w = -outward[m] * scale[m] * thick * EDGE_N[p, k] * EDGE_W[p]
+                for i in range(3):
+                    f[node, i] += w * out[i]

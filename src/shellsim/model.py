@@ -1,0 +1,303 @@
+"""Deck + Mesh -> Model: the flat arrays the compiled kernels see, and nothing else.
+
+Boundary conditions become, per node, a projector on the translational velocity and a
+free/fixed flag for each of the two rotational DOFs, with the nodal fibre frame turned so
+that a director constraint is one of those DOFs (symmetry plane or edge support: e1f is
+the plane's normal, whose rotation is fixed). Loads become tables: dead nodal vectors
+(edge, point, body, dead pressure) and follower pressures evaluated every step, each with
+the index of its time curve (-1: constant).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .deck import Deck
+from .element import kernels
+from .element.frames import initial_fibre_frame
+from .element.shape import EDGES, gauss_rule, gauss_rule_2d, shape, shape_derivatives
+from .errors import NotYetAvailable
+from .materials.linear import reduced_lamina_matrix
+from .mesh import Mesh
+
+AXES = {"x": 0, "y": 1, "z": 2}
+FACES = {"bottom": -1, "mid": 0, "top": 1}
+
+
+@dataclass
+class Model:
+    """Everything the time loop needs, as arrays (shapes in brackets, n nodes, ne elements).
+
+    x0, d0 [n, 3]: initial mid-surface and directors; h0 [n]: fibre lengths;
+    e1f0 [n, 3]: initial fibre-frame first axes; conn [ne, 9].
+    N, dNr, dNs [nq, 9], wq [nq]: in-plane rule; tz, wt [nt]: thickness rule.
+    jac0_inv [ne, nq, nt, 3, 3]: inverse initial Jacobians.
+    C [5, 5]: reduced lamina matrix; density; mass 'M1'/'M2'; damping [1/s].
+    projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
+    prescribed_*: nodes, axes, values, curves of prescribed translations.
+    dead_force, dead_moment [L, n, 3] with dead_curve [L].
+    pressure_elements, pressure_face, pressure_value, pressure_curve [P].
+    edge_pressure_edges [E, 3], edge_pressure_outward, edge_pressure_value, edge_pressure_curve [E].
+    curve_t, curve_v [C, K] padded tables; curve_len, curve_interp, curve_extrap [C].
+    """
+
+    x0: np.ndarray
+    d0: np.ndarray
+    h0: np.ndarray
+    e1f0: np.ndarray
+    conn: np.ndarray
+    N: np.ndarray
+    dNr: np.ndarray
+    dNs: np.ndarray
+    wq: np.ndarray
+    tz: np.ndarray
+    wt: np.ndarray
+    jac0_inv: np.ndarray
+    C: np.ndarray
+    density: float
+    mass: str
+    damping: float
+    incremental: bool
+    projector: np.ndarray
+    rot_free: np.ndarray
+    prescribed_nodes: np.ndarray
+    prescribed_axes: np.ndarray
+    prescribed_values: np.ndarray
+    prescribed_curves: np.ndarray
+    dead_force: np.ndarray
+    dead_moment: np.ndarray
+    dead_curve: np.ndarray
+    pressure_elements: np.ndarray
+    pressure_face: np.ndarray
+    pressure_value: np.ndarray
+    pressure_curve: np.ndarray
+    edge_pressure_edges: np.ndarray
+    edge_pressure_outward: np.ndarray
+    edge_pressure_value: np.ndarray
+    edge_pressure_curve: np.ndarray
+    curve_t: np.ndarray
+    curve_v: np.ndarray
+    curve_len: np.ndarray
+    curve_interp: np.ndarray
+    curve_extrap: np.ndarray
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.x0)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.conn)
+
+
+def integration_rule(points_through_thickness: int):
+    """(N, dNr, dNs, wq, tz, wt): 3 x 3 in-plane Gauss rule and ``points_through_thickness``
+    Gauss points through the thickness (thesis 3.15)."""
+    rs, wq = gauss_rule_2d(3)
+    dN = shape_derivatives(rs)
+    tz, wt = gauss_rule(points_through_thickness)
+    return shape(rs), np.ascontiguousarray(dN[:, :, 0]), np.ascontiguousarray(dN[:, :, 1]), wq, tz, wt
+
+
+def build_model(deck: Deck, mesh: Mesh) -> Model:
+    """Flatten ``deck`` and ``mesh`` into a :class:`Model`."""
+    material = deck.material
+    if material.model != "linear_elastic":
+        raise NotYetAvailable(f"material.model = '{material.model}' needs the large-strain "
+                              "constitutive laws, which are not available yet")
+    N, dNr, dNs, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
+    C = reduced_lamina_matrix(material.E, material.nu, deck.section.plane_strain)
+    jac0_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)
+    projector, rot_free, e1f0, prescribed = _boundary_conditions(deck, mesh)
+    curve_names = list(deck.curves)
+    loads = _loads(deck, mesh, curve_names, N, dNr, dNs, wq, tz, wt)
+    tables = _curve_tables(deck, curve_names)
+    return Model(
+        x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
+        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, wq=wq, tz=tz, wt=wt,
+        jac0_inv=jac0_inv, C=C, density=material.density, mass=deck.solver.mass,
+        damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
+        projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
+    )
+
+
+def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
+    """(ne, nq, nt, 3, 3) inverses of dy/d(r, s, t) on the initial configuration."""
+    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
+    out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
+    for k, t in enumerate(tz):
+        pos = xe + t * fe
+        jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
+                        np.einsum("qa,eai->eqi", N, fe)], axis=-1)  # columns d/dr, d/ds, d/dt
+        out[:, :, k] = np.linalg.inv(jac)
+    return out
+
+
+def _boundary_conditions(deck: Deck, mesh: Mesh):
+    n = mesh.n_nodes
+    constrained: list[list[np.ndarray]] = [[] for _ in range(n)]
+    planes: list[list[np.ndarray]] = [[] for _ in range(n)]
+    director_fixed = np.zeros(n, dtype=bool)
+    prescribed = {"prescribed_nodes": [], "prescribed_axes": [], "prescribed_values": [], "prescribed_curves": []}
+    axes = np.eye(3)
+    for bc in deck.boundary:
+        nodes = mesh.sets[bc.set].nodes
+        if bc.type == "clamped":
+            directions, plane, fixed = list(axes), None, True
+        elif bc.type == "fixed":
+            directions = [axes[AXES[a]] for a in bc.translations]
+            plane = None if bc.director_plane_normal is None else np.asarray(bc.director_plane_normal)
+            fixed = bc.director == "fixed"
+        elif bc.type == "symmetry":
+            directions, plane, fixed = [np.asarray(bc.normal)], np.asarray(bc.normal), False
+        else:  # prescribed
+            directions, plane, fixed = [axes[AXES[bc.translation]]], None, False
+            for node in nodes:
+                prescribed["prescribed_nodes"].append(node)
+                prescribed["prescribed_axes"].append(AXES[bc.translation])
+                prescribed["prescribed_values"].append(bc.value)
+                prescribed["prescribed_curves"].append(_curve_index(deck, bc.curve))
+        for node in nodes:
+            constrained[node].extend(directions)
+            if plane is not None:
+                planes[node].append(plane)
+            director_fixed[node] |= fixed
+    projector = np.empty((n, 3, 3))
+    rot_free = np.ones((n, 2))
+    e1f0 = np.empty((n, 3))
+    for node in range(n):
+        basis = _orthonormal(constrained[node])
+        projector[node] = np.eye(3) - sum((np.outer(b, b) for b in basis), np.zeros((3, 3)))
+        d = mesh.director[node]
+        initial_fibre_frame(d, e1f0[node])
+        in_plane = _orthonormal([p - (p @ d) * d for p in planes[node]])
+        if director_fixed[node] or len(in_plane) >= 2:
+            rot_free[node] = 0.0
+        elif len(in_plane) == 1:
+            # Turn the fibre frame so that e1f is the plane's normal: the director may not
+            # move along it, which is the first rotational DOF.
+            e1f0[node] = in_plane[0]
+            rot_free[node, 0] = 0.0
+    arrays = {
+        "prescribed_nodes": np.asarray(prescribed["prescribed_nodes"], dtype=np.int64),
+        "prescribed_axes": np.asarray(prescribed["prescribed_axes"], dtype=np.int64),
+        "prescribed_values": np.asarray(prescribed["prescribed_values"], dtype=float),
+        "prescribed_curves": np.asarray(prescribed["prescribed_curves"], dtype=np.int64),
+    }
+    return projector, rot_free, e1f0, arrays
+
+
+def _orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarray]:
+    """Gram-Schmidt basis of the span of ``vectors`` (dependent ones dropped)."""
+    basis: list[np.ndarray] = []
+    for v in vectors:
+        w = np.asarray(v, dtype=float) - sum(((b @ v) * b for b in basis), np.zeros(3))
+        norm = np.linalg.norm(w)
+        if norm > tol:
+            basis.append(w / norm)
+    return basis
+
+
+def _curve_index(deck: Deck, name: str | None) -> int:
+    return -1 if name is None else list(deck.curves).index(name)
+
+
+def _curve_tables(deck: Deck, names: list[str]) -> dict[str, np.ndarray]:
+    size = max([len(deck.curves[c].t) for c in names], default=1)
+    t = np.zeros((max(len(names), 1), size))
+    v = np.zeros_like(t)
+    length = np.ones(max(len(names), 1), dtype=np.int64)
+    interp = np.zeros(max(len(names), 1), dtype=np.int64)
+    extrap = np.zeros_like(interp)
+    for i, name in enumerate(names):
+        times, values, interp[i], extrap[i] = deck.curves[name].table()
+        length[i] = len(times)
+        t[i, :len(times)], v[i, :len(times)] = times, values
+    return {"curve_t": t, "curve_v": v, "curve_len": length, "curve_interp": interp, "curve_extrap": extrap}
+
+
+def _edge_integral(x0: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Consistent nodal weights int N_k ds over edge segments (m, 3) on the initial
+    geometry: (m, 3) lengths (1/6 : 4/6 : 1/6 of a straight segment)."""
+    tangent = np.einsum("pk,mki->mpi", kernels.EDGE_DN, x0[edges])
+    return np.einsum("pk,mp,p->mk", kernels.EDGE_N, np.linalg.norm(tangent, axis=-1), kernels.EDGE_W)
+
+
+def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict[str, np.ndarray]:
+    n = mesh.n_nodes
+    dead_force, dead_moment, dead_curve = [], [], []
+    pressure = {"elements": [], "face": [], "value": [], "curve": []}
+    edge_pressure = {"edges": [], "outward": [], "value": [], "curve": []}
+    for load in deck.load:
+        named = mesh.sets[load.set]
+        curve = _curve_index(deck, load.curve)
+        force, moment = np.zeros((n, 3)), np.zeros((n, 3))
+        if load.type == "pressure" and load.follower:
+            pressure["elements"].append(named.elements)
+            pressure["face"].append(np.full(len(named.elements), FACES[load.face]))
+            pressure["value"].append(np.full(len(named.elements), load.value))
+            pressure["curve"].append(np.full(len(named.elements), curve))
+            continue
+        if load.type == "edge_pressure":
+            edge_pressure["edges"].append(named.edges)
+            edge_pressure["outward"].append(_outward_signs(mesh, named.edges))
+            edge_pressure["value"].append(np.full(len(named.edges), load.value))
+            edge_pressure["curve"].append(np.full(len(named.edges), curve))
+            continue
+        if load.type == "pressure":  # dead: forces of the initial face, kept fixed
+            g = np.zeros((n, 3))
+            kernels.pressure_forces(mesh.x, mesh.director, mesh.thickness, mesh.conn.astype(np.int64),
+                                    named.elements.astype(np.int64), np.full(len(named.elements), FACES[load.face]),
+                                    np.full(len(named.elements), load.value), N, dNr, dNs, wq, force, g)
+        elif load.type in ("edge_force", "edge_moment"):
+            target = force if load.type == "edge_force" else moment
+            np.add.at(target, named.edges, _edge_integral(mesh.x, named.edges)[:, :, None] * np.asarray(load.value))
+        elif load.type in ("point_force", "point_moment"):
+            (force if load.type == "point_force" else moment)[named.nodes] += np.asarray(load.value)
+        else:  # body force per unit initial volume
+            volume_weights = _nodal_volumes(mesh, named.elements, N, dNr, dNs, wq, tz, wt)
+            force += volume_weights[:, None] * np.asarray(load.value)
+        dead_force.append(force)
+        dead_moment.append(moment)
+        dead_curve.append(curve)
+
+    def cat(parts, dtype, shape=(0,)):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype=dtype)
+
+    return {
+        "dead_force": np.asarray(dead_force).reshape(-1, n, 3),
+        "dead_moment": np.asarray(dead_moment).reshape(-1, n, 3),
+        "dead_curve": np.asarray(dead_curve, dtype=np.int64),
+        "pressure_elements": cat(pressure["elements"], np.int64),
+        "pressure_face": cat(pressure["face"], np.int64),
+        "pressure_value": cat(pressure["value"], float),
+        "pressure_curve": cat(pressure["curve"], np.int64),
+        "edge_pressure_edges": cat(edge_pressure["edges"], np.int64, (0, 3)),
+        "edge_pressure_outward": cat(edge_pressure["outward"], float),
+        "edge_pressure_value": cat(edge_pressure["value"], float),
+        "edge_pressure_curve": cat(edge_pressure["curve"], np.int64),
+    }
+
+
+def _nodal_volumes(mesh: Mesh, elements, N, dNr, dNs, wq, tz, wt) -> np.ndarray:
+    """int N_a dV over ``elements`` on the initial configuration, per node: (n,)."""
+    jac_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)[elements]
+    dv = np.einsum("q,t,eqt->eqt", wq, wt, 1.0 / np.linalg.det(jac_inv))
+    out = np.zeros(mesh.n_nodes)
+    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", N, dv))
+    return out
+
+
+def _outward_signs(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
+    """+1 where tangent x director points away from the element owning the edge, else -1."""
+    triples = mesh.conn[:, EDGES]  # (ne, 4, 3)
+    owner = {frozenset(t): e for e, four in enumerate(triples.tolist()) for t in four}
+    signs = np.empty(len(edges))
+    for m, edge in enumerate(edges):
+        e = owner[frozenset(edge.tolist())]
+        tangent = mesh.x[edge[2]] - mesh.x[edge[0]]
+        out = np.cross(tangent, mesh.director[edge[1]])
+        signs[m] = 1.0 if out @ (mesh.x[edge[1]] - mesh.x[mesh.conn[e, 8]]) > 0 else -1.0
+    return signs

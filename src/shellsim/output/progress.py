@@ -1,0 +1,51 @@
+"""Progress of a run: a rich bar on a terminal (simulated time, step, steps per second,
+energy balance, time left), a line every tenth of the run otherwise, nothing when quiet."""
+
+from __future__ import annotations
+
+import time
+
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+from ..solver.run import Listener, Run
+
+
+class ProgressDisplay(Listener):
+    def __init__(self, console: Console, end_time: float, quiet: bool = False):
+        self.console = console
+        self.end_time = end_time
+        self.quiet = quiet
+        self.started = time.perf_counter()
+        self.next_line = 0.1
+        self.bar: Progress | None = None
+        if not quiet and console.is_terminal:
+            self.bar = Progress(TextColumn("[bold]t = {task.fields[t]}"), BarColumn(),
+                                TextColumn("dt {task.fields[dt]}  {task.fields[rate]} steps/s  "
+                                           "balance {task.fields[balance]}"),
+                                TimeRemainingColumn(), console=console, transient=True)
+            self.task = self.bar.add_task("run", total=end_time, t="0", dt="-", rate="-", balance="-")
+            self.bar.start()
+
+    def _fields(self, run: Run) -> dict:
+        elapsed = max(time.perf_counter() - self.started, 1e-9)
+        e = run.sim.state.energy
+        scale = max(abs(e[2]), 1e-300)
+        return {"t": f"{run.sim.state.t:.4g}", "dt": f"{run.dt:.3g}",
+                "rate": f"{run.sim.state.steps / elapsed:,.0f}",
+                "balance": f"{100 * run.balance_error / scale:+.2f}%"}
+
+    def on_sample(self, run: Run) -> None:
+        if self.quiet:
+            return
+        if self.bar is not None:
+            self.bar.update(self.task, completed=run.sim.state.t, **self._fields(run))
+        elif run.sim.state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
+            f = self._fields(run)
+            self.console.print(f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
+                               f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}", highlight=False)
+            self.next_line += 0.1
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.stop()

@@ -1,0 +1,59 @@
+"""summary.json: what was run, how long it took, the energy balance, what the scene used
+and left out, and each reference check."""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..plan import Plan
+from ..solver.explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
+from ..solver.run import Run, dt_statistics
+from ..verify.check import check
+
+
+def reference_results(run: Run) -> list[dict]:
+    """One entry per [reference] of the deck, from the recorded probe histories."""
+    times = np.asarray(run.times)
+    return [check(ref, times, np.asarray(run.history[ref.probe])) for ref in run.deck.reference]
+
+
+def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None) -> dict:
+    state, model = run.sim.state, run.model
+    e = state.energy
+    steps = max(state.steps, 1)
+    scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC], 1e-300)
+    return {
+        "deck": str(deck_path),
+        "title": run.deck.meta.title,
+        "version": __version__,
+        "status": run.status,
+        "message": message,
+        "elements": model.n_elements,
+        "nodes": model.n_nodes,
+        "dofs": 5 * model.n_nodes,
+        "steps": state.steps,
+        "sim_time": state.t,
+        "wall_time_s": run.wall_time,
+        "us_per_element_step": 1e6 * run.wall_time / (steps * model.n_elements),
+        "dt": dt_statistics(run),
+        "energy": {
+            "internal": float(e[INTERNAL]), "kinetic": float(e[KINETIC]),
+            "external_work": float(e[EXTERNAL]), "damping_work": float(e[DAMPED]),
+            "balance_error": run.balance_error,
+            "balance_error_percent": 100.0 * run.balance_error / scale,
+        },
+        "features": {"used": plan.used(), "left_out": plan.left_out()},
+        "reference": reference_results(run),
+    }
+
+
+def write_json(data: dict, path: Path) -> None:
+    """Write ``data`` atomically (a reader never sees half a file)."""
+    partial = path.with_suffix(".json.partial")
+    partial.write_text(json.dumps(data, indent=2, allow_nan=True) + "\n", encoding="utf-8")
+    os.replace(partial, path)

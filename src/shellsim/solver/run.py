@@ -1,0 +1,219 @@
+"""Running a scene: the time step schedule, history sampling, stability watch, and the
+events that writers and the progress display listen to.
+
+The solver knows nothing about files: it calls ``listener.on_sample(run)`` at every
+history time and ``listener.on_dt(run)`` after each critical-step estimate.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..deck import Deck
+from ..errors import NotYetAvailable, NumericalError
+from ..mesh import Mesh
+from ..model import Model
+from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
+from .simulation import Simulation
+
+#: History samples over a run (fewer when the run has fewer steps).
+HISTORY_SAMPLES = 2000
+#: Energy balance error (share of the largest energy) beyond which a run is unstable.
+UNSTABLE_BALANCE = 0.5
+#: Energies below this share of the external work are round-off, not a balance to judge.
+ENERGY_FLOOR = 1e-12
+NODAL_QUANTITIES = ("displacement", "position", "director", "rotation", "thickness")
+
+
+@dataclass
+class Probe:
+    """Where a deck's probe reads: its nodes, quantity and component."""
+
+    name: str
+    quantity: str
+    component: str
+    nodes: np.ndarray
+
+
+@dataclass
+class Run:
+    """A scene being run: the simulation, its time step record and probe histories."""
+
+    deck: Deck
+    mesh: Mesh
+    model: Model
+    sim: Simulation
+    probes: list[Probe]
+    dt: float = 0.0
+    dt_critical: float = 0.0
+    dt_history: list[tuple[float, float, float]] = field(default_factory=list)  # (t, dt_crit, dt)
+    times: list[float] = field(default_factory=list)
+    history: dict[str, list[float]] = field(default_factory=dict)
+    energies: list[np.ndarray] = field(default_factory=list)
+    wall_time: float = 0.0
+    status: str = "running"
+
+    @property
+    def balance_error(self) -> float:
+        """(internal + kinetic + damping - external) energy now."""
+        e = self.sim.state.energy
+        return float(e[INTERNAL] + e[KINETIC] + e[DAMPED] - e[EXTERNAL])
+
+
+class Listener:
+    """Receives run events; subclasses override what they need."""
+
+    def on_dt(self, run: Run) -> None:
+        pass
+
+    def on_sample(self, run: Run) -> None:
+        pass
+
+
+class Listeners(Listener):
+    """Passes every event to each of several listeners, in order."""
+
+    def __init__(self, *listeners: Listener):
+        self.listeners = listeners
+
+    def on_dt(self, run: Run) -> None:
+        for listener in self.listeners:
+            listener.on_dt(run)
+
+    def on_sample(self, run: Run) -> None:
+        for listener in self.listeners:
+            listener.on_sample(run)
+
+
+def probe_value(run: Run, probe: Probe) -> float:
+    """The probe's current value (the mean over its nodes)."""
+    s, m = run.sim.state, run.model
+    nodes = probe.nodes
+    if probe.quantity == "thickness":
+        return float(s.h[nodes].mean())
+    if probe.quantity == "rotation":
+        return float(np.linalg.norm(s.theta[nodes], axis=1).mean())
+    vector = {"displacement": s.x - m.x0, "position": s.x, "director": s.d}[probe.quantity][nodes].mean(axis=0)
+    if probe.component == "magnitude":
+        return float(np.linalg.norm(vector))
+    return float(vector["xyz".index(probe.component)])
+
+
+def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
+    """A run ready to start: simulation built, probes resolved."""
+    probes = []
+    for p in deck.output.probe:
+        if p.quantity not in NODAL_QUANTITIES:
+            raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
+        probes.append(Probe(p.name, p.quantity, p.component, mesh.sets[p.set].nodes))
+    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
+    run.history = {p.name: [] for p in probes}
+    return run
+
+
+def output_times(deck: Deck) -> np.ndarray:
+    """Times the run lands on exactly: the deck's output times (or every output interval)
+    and the end time."""
+    end = deck.solver.end_time
+    out = deck.output
+    if out.times is not None:
+        marks = np.asarray([t for t in out.times if 0.0 < t <= end])
+    elif out.interval is not None:
+        marks = np.arange(out.interval, end, out.interval)
+    else:
+        marks = np.zeros(0)
+    times = np.unique(np.append(marks, end))
+    return times[times > 0.0]
+
+
+def _record(run: Run, listener: Listener) -> None:
+    run.times.append(run.sim.state.t)
+    for p in run.probes:
+        run.history[p.name].append(probe_value(run, p))
+    run.energies.append(run.sim.state.energy.copy())
+    listener.on_sample(run)
+
+
+def _update_time_step(run: Run, listener: Listener) -> None:
+    solver = run.deck.solver
+    run.sim.update_masses()
+    run.dt_critical = run.sim.critical_time_step()
+    run.dt = run.dt_critical / solver.dt_safety_factor
+    if solver.dt_max is not None:
+        run.dt = min(run.dt, solver.dt_max)
+    run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
+    listener.on_dt(run)
+
+
+def _check_stability(run: Run) -> None:
+    s = run.sim.state
+    e = s.energy
+    scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC] + e[DAMPED])
+    broken = not (np.isfinite(s.x).all() and np.isfinite(e).all())
+    if not broken and scale > ENERGY_FLOOR * max(abs(e[EXTERNAL]), 1e-300):
+        broken = abs(run.balance_error) > UNSTABLE_BALANCE * scale and run.balance_error > 0
+    if broken:
+        factor = run.deck.solver.dt_safety_factor
+        hint = (f"; solver.dt_safety_factor = {factor} < 1 puts the step above the critical step"
+                if factor < 1 else "; a larger solver.dt_safety_factor or dt_update_every smaller may help")
+        raise NumericalError(
+            f"the run became unstable at t = {s.t:.6g} after {s.steps} steps: energy is being "
+            f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()}); "
+            f"time step {run.dt:.4g}, critical step {run.dt_critical:.4g}{hint}")
+
+
+def integrate(run: Run, listener: Listener | None = None) -> Run:
+    """Integrate the scene from t = 0 to the deck's end time.
+
+    Raises NumericalError when the run goes unstable (the samples recorded until then stay
+    in ``run``); KeyboardInterrupt passes through with ``run.status = 'interrupted'``.
+    """
+    listener = listener or Listener()
+    solver = run.deck.solver
+    sim = run.sim
+    start = time.perf_counter()
+    try:
+        _update_time_step(run, listener)
+        _record(run, listener)
+        since_update = 0
+        history_interval = solver.end_time / HISTORY_SAMPLES
+        for landing in output_times(run.deck):
+            while sim.state.t < landing:
+                # Equal steps up to the next output time, history samples on whole steps:
+                # a short step among long ones near the critical step pumps energy into
+                # the highest modes.
+                remaining = landing - sim.state.t
+                step = remaining / max(1.0, math.ceil(remaining / run.dt - 1e-9))
+                target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
+                while sim.state.t < target:
+                    steps = sim.advance(target, step, solver.dt_update_every - since_update)
+                    since_update += steps
+                    if since_update >= solver.dt_update_every:
+                        _update_time_step(run, listener)
+                        since_update = 0
+                        break  # re-plan the steps with the new dt
+                _record(run, listener)
+                _check_stability(run)
+        run.status = "completed"
+    except NumericalError:
+        run.status = "unstable"
+        raise
+    except KeyboardInterrupt:
+        run.status = "interrupted"
+        raise
+    finally:
+        run.wall_time = time.perf_counter() - start
+    return run
+
+
+def dt_statistics(run: Run) -> dict:
+    """Minimum, mean and maximum step over the run, and the critical-step record."""
+    steps = max(run.sim.state.steps, 1)
+    dts = [dt for _, _, dt in run.dt_history] or [math.nan]
+    return {"min": min(dts), "mean": run.sim.state.t / steps, "max": max(dts),
+            "critical_min": min((c for _, c, _ in run.dt_history), default=math.nan),
+            "updates": len(run.dt_history)}

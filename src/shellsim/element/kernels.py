@@ -243,13 +243,18 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, jac0_inv, C,
 
 @njit(cache=True)
 def _almansi(F, eg):
-    """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3)."""
+    """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3).
+    A degenerate F gives non-finite values (no exception), which the time loop detects."""
     B = F @ F.T
-    Bi = np.linalg.inv(B)
-    for i in range(3):
-        for j in range(3):
-            eg[i, j] = -0.5 * Bi[i, j]
-        eg[i, i] += 0.5
+    det = (B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1])
+           - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
+           + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0]))
+    eg[0, 0] = 0.5 - 0.5 * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) / det
+    eg[1, 1] = 0.5 - 0.5 * (B[0, 0] * B[2, 2] - B[0, 2] * B[2, 0]) / det
+    eg[2, 2] = 0.5 - 0.5 * (B[0, 0] * B[1, 1] - B[0, 1] * B[1, 0]) / det
+    eg[0, 1] = eg[1, 0] = -0.5 * (B[0, 2] * B[2, 1] - B[0, 1] * B[2, 2]) / det
+    eg[0, 2] = eg[2, 0] = -0.5 * (B[0, 1] * B[1, 2] - B[0, 2] * B[1, 1]) / det
+    eg[1, 2] = eg[2, 1] = -0.5 * (B[0, 2] * B[1, 0] - B[0, 0] * B[1, 2]) / det
 
 
 @njit(cache=True)

@@ -178,4 +178,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
         work[DAMPED] += damped
         dt_prev = step
         steps += 1
+        if not np.isfinite(work_int + work_ext + kinetic):
+            energy[INTERNAL] = work[INTERNAL]  # let the caller see the failure at once
+            break
     return t, dt_prev, steps

@@ -1,0 +1,107 @@
+"""The explicit solver: energy balance, a step above the critical one caught with a clear
+message (and the results so far kept), the reference measures, and Test 1 against its
+analytic reference."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.deck import load_deck, parse_deck
+from shellsim.deck.schema import Reference
+from shellsim.errors import NumericalError
+from shellsim.geometry import build_mesh
+from shellsim.model import build_model
+from shellsim.solver.explicit import EXTERNAL
+from shellsim.solver.run import integrate, prepare
+from shellsim.verify.check import check, first_peak
+
+from .conftest import ROOT
+
+PLATE = ROOT / "decks" / "verification" / "test01_plate_step_2x2.toml"
+
+
+def run_deck(deck):
+    mesh = build_mesh(deck)
+    return integrate(prepare(deck, mesh, build_model(deck, mesh)))
+
+
+@pytest.fixture(scope="module")
+def plate_run():
+    return run_deck(load_deck(PLATE))
+
+
+def test_undamped_run_conserves_energy(plate_run):
+    e = plate_run.sim.state.energy
+    assert e[EXTERNAL] > 0
+    assert abs(plate_run.balance_error) < 0.01 * e[EXTERNAL]
+
+
+def test_plate_step_response_matches_the_mindlin_reference(plate_run):
+    """Test 1 (benchmarks 1A): amplitude within 2% of the Mindlin static deflection and
+    first peak within 2% of half the first Mindlin period."""
+    times = np.asarray(plate_run.times)
+    for reference in plate_run.deck.reference:
+        result = check(reference, times, np.asarray(plate_run.history[reference.probe]))
+        assert result["passed"], result
+
+
+def test_the_critical_step_is_refreshed_on_schedule(plate_run):
+    steps = plate_run.sim.state.steps
+    every = plate_run.deck.solver.dt_update_every
+    assert len(plate_run.dt_history) == 1 + steps // every
+    assert all(dt < crit for _, crit, dt in plate_run.dt_history)
+
+
+def test_a_step_above_the_critical_one_is_stopped_with_a_clear_message():
+    deck = parse_deck(PLATE.read_text().replace("[solver]\n", "[solver]\ndt_safety_factor = 0.8\n"))
+    with pytest.raises(NumericalError, match=r"unstable.*dt_safety_factor = 0.8 < 1"):
+        run_deck(deck)
+
+
+def test_an_unstable_run_keeps_what_it_wrote(tmp_path):
+    deck = tmp_path / "unstable.toml"
+    deck.write_text(PLATE.read_text().replace("[solver]\n", "[solver]\ndt_safety_factor = 0.8\n"))
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 3
+    assert "unstable" in result.output and "Traceback" not in result.output
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "unstable" and "dt_safety_factor" in summary["message"]
+    rows = (tmp_path / "out" / "history.csv").read_text().splitlines()
+    assert len(rows) > 2 and rows[0].startswith("time,dt,")
+
+
+def test_run_writes_a_summary_with_the_reference_checks(tmp_path):
+    result = CliRunner().invoke(app, ["run", str(PLATE), "--out", str(tmp_path), "--quiet"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    for key in ("deck", "elements", "nodes", "dofs", "steps", "sim_time", "wall_time_s",
+                "us_per_element_step", "dt", "energy", "features", "reference"):
+        assert key in summary
+    assert summary["status"] == "completed" and summary["sim_time"] == pytest.approx(1.6e-3)
+    assert {"min", "mean", "max"} <= set(summary["dt"])
+    assert {"internal", "kinetic", "external_work", "balance_error"} <= set(summary["energy"])
+    assert "dead_pressure" in summary["features"]["used"] and "hyperelastic" in summary["features"]["left_out"]
+    assert all(r["passed"] for r in summary["reference"])
+
+
+def test_first_peak_of_a_step_response_ignores_ripples():
+    t = np.linspace(0.0, 3.0, 3001)
+    omega = np.pi  # peak at t = 1
+    signal = 1 - np.cos(omega * t) + 0.004 * np.sin(37 * t)  # a ripple shifts the maximum
+    peak_time, peak = first_peak(t, signal)
+    assert peak_time == pytest.approx(1.0, abs=2e-3)
+    assert peak == pytest.approx(2.0, abs=0.01)
+
+
+def test_reference_measures_and_tolerances():
+    t = np.linspace(0.0, 1.0, 11)
+    values = 2 * t
+    ref = dict(quantity="q", probe="p", source="closed form", expected=1.0)
+    assert check(Reference(**ref, measure="at_time", time=0.5, tolerance_percent=0.1), t, values)["passed"]
+    assert not check(Reference(**ref, measure="final", tolerance_percent=10.0), t, values)["passed"]
+    assert check(Reference(**ref | {"expected": 2.05}, measure="max", tolerance=0.1), t, values)["passed"]

@@ -32,8 +32,10 @@ class Model:
 
     x0, d0 [n, 3]: initial mid-surface and directors; h0 [n]: fibre lengths;
     e1f0 [n, 3]: initial fibre-frame first axes; conn [ne, 9].
-    N, dNr, dNs [nq, 9], wq [nq]: in-plane rule; tz, wt [nt]: thickness rule.
-    jac0_inv [ne, nq, nt, 3, 3]: inverse initial Jacobians.
+    N, dNr, dNs [nq + 4, 9]: shape functions at the 3 x 3 integration points and the
+    2 x 2 membrane sampling points; L [nq, 4]: interpolation from the latter; wq [nq]:
+    in-plane weights; tz, wt [nt]: thickness rule.
+    jac0_inv [ne, nq + 4, nt, 3, 3]: inverse initial Jacobians.
     C [5, 5]: reduced lamina matrix; density; mass 'M1'/'M2'; damping [1/s].
     projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
     prescribed_*: nodes, axes, values, curves of prescribed translations.
@@ -51,6 +53,7 @@ class Model:
     N: np.ndarray
     dNr: np.ndarray
     dNs: np.ndarray
+    L: np.ndarray
     wq: np.ndarray
     tz: np.ndarray
     wt: np.ndarray
@@ -93,12 +96,23 @@ class Model:
 
 
 def integration_rule(points_through_thickness: int):
-    """(N, dNr, dNs, wq, tz, wt): 3 x 3 in-plane Gauss rule and ``points_through_thickness``
-    Gauss points through the thickness (thesis 3.15)."""
+    """(N, dNr, dNs, L, wq, tz, wt) of the element.
+
+    N, dNr, dNs (13, 9): shape functions and derivatives at the 3 x 3 Gauss points
+    (rows 0-8, thesis 3.15) followed by the 2 x 2 Gauss points (rows 9-12) where membrane
+    strains are sampled; L (9, 4): bilinear interpolation from the 2 x 2 points to the
+    3 x 3 ones; wq (9,): in-plane weights; tz, wt: ``points_through_thickness`` Gauss
+    points and weights through the thickness.
+    """
     rs, wq = gauss_rule_2d(3)
-    dN = shape_derivatives(rs)
+    sampling, _ = gauss_rule_2d(2)
+    points = np.vstack([rs, sampling])
+    dN = shape_derivatives(points)
+    # L_g(r, s) = (1 + r / r_g)(1 + s / s_g) / 4 is 1 at sampling point g, 0 at the others
+    L = 0.25 * (1 + rs[:, None, 0] / sampling[None, :, 0]) * (1 + rs[:, None, 1] / sampling[None, :, 1])
     tz, wt = gauss_rule(points_through_thickness)
-    return shape(rs), np.ascontiguousarray(dN[:, :, 0]), np.ascontiguousarray(dN[:, :, 1]), wq, tz, wt
+    return (shape(points), np.ascontiguousarray(dN[:, :, 0]), np.ascontiguousarray(dN[:, :, 1]),
+            L, wq, tz, wt)
 
 
 def build_model(deck: Deck, mesh: Mesh) -> Model:
@@ -107,7 +121,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     if material.model != "linear_elastic":
         raise NotYetAvailable(f"material.model = '{material.model}' needs the large-strain "
                               "constitutive laws, which are not available yet")
-    N, dNr, dNs, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
+    N, dNr, dNs, L, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
     C = reduced_lamina_matrix(material.E, material.nu, deck.section.plane_strain)
     jac0_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)
     projector, rot_free, e1f0, prescribed = _boundary_conditions(deck, mesh)
@@ -116,7 +130,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     tables = _curve_tables(deck, curve_names)
     return Model(
         x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
-        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, wq=wq, tz=tz, wt=wt,
+        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, L=L, wq=wq, tz=tz, wt=wt,
         jac0_inv=jac0_inv, C=C, density=material.density, mass=deck.solver.mass,
         damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
         projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
@@ -283,10 +297,11 @@ def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict
 
 def _nodal_volumes(mesh: Mesh, elements, N, dNr, dNs, wq, tz, wt) -> np.ndarray:
     """int N_a dV over ``elements`` on the initial configuration, per node: (n,)."""
-    jac_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)[elements]
+    nq = len(wq)
+    jac_inv = _initial_inverse_jacobians(mesh, N[:nq], dNr[:nq], dNs[:nq], tz)[elements]
     dv = np.einsum("q,t,eqt->eqt", wq, wt, 1.0 / np.linalg.det(jac_inv))
     out = np.zeros(mesh.n_nodes)
-    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", N, dv))
+    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", N[:nq], dv))
     return out
 
 

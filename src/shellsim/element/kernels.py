@@ -150,95 +150,8 @@ def director_increments(w, d, e1, out):
         out[n, 2] = -w[n, 0] * e1[n, 2] - w[n, 1] * e2z
 
 
-@njit(cache=True)
-def internal_forces(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, jac0_inv, C,
-                    incremental, dx, dd, stress, f, fr):
-    """Internal forces of all elements at the current configuration.
-
-    Parameters
-    ----------
-    x, d : (n, 3) current mid-surface positions and unit directors.
-    h : (n,) fibre lengths. e1 : (n, 3) fibre-frame first axes.
-    conn : (ne, 9). N, dNr, dNs : (nq, 9) shape functions and derivatives at the
-        in-plane points; wq (nq,). tz, wt : (nt,) thickness points and weights.
-    jac0_inv : (ne, nq, nt, 3, 3) inverse reference Jacobians (total formulation).
-    C : (5, 5) reduced lamina constitutive matrix.
-    incremental : False for the total formulation (stress from the total deformation,
-        Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
-        in the lamina frame plus C~ times the strain increment of the last step, Eq 3.2).
-    dx, dd : (n, 3) last step's mid-surface and director increments (incremental only).
-    stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
-    f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
-    """
-    nn = x.shape[0]
-    f[:] = 0.0
-    g = np.zeros((nn, 3))
-    jac = np.empty((3, 3))
-    jinv = np.empty((3, 3))
-    q = np.empty((3, 3))
-    gN = np.empty((9, 3))
-    gM = np.empty((9, 3))
-    sg = np.empty((3, 3))
-    L = np.empty((3, 3))
-    eg = np.empty((3, 3))
-    e5 = np.empty(5)
-    xe = np.empty((9, 3))
-    de = np.empty((9, 3))
-    he = np.empty(9)
-    ue = np.empty((9, 3))
-    ve = np.empty((9, 3))
-    fe = np.empty((9, 3))
-    ge = np.empty((9, 3))
-    for e in range(conn.shape[0]):
-        for a in range(9):
-            node = conn[e, a]
-            he[a] = h[node]
-            for i in range(3):
-                xe[a, i] = x[node, i]
-                de[a, i] = d[node, i]
-                ue[a, i] = dx[node, i]
-                ve[a, i] = dd[node, i]
-        fe[:] = 0.0
-        ge[:] = 0.0
-        for p in range(N.shape[0]):
-            for k in range(tz.shape[0]):
-                det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
-                if incremental:
-                    _gradient_of(ue, ve, gN, gM, L)
-                    for i in range(3):
-                        for j in range(3):
-                            eg[i, j] = 0.5 * (L[i, j] + L[j, i])
-                    _global_to_lamina_strain(eg, q, e5)
-                    for i in range(5):
-                        acc = 0.0
-                        for j in range(5):
-                            acc += C[i, j] * e5[j]
-                        stress[e, p, k, i] += acc
-                else:
-                    # F = J J0^-1; Almansi strain 1/2 (I - (F F^T)^-1) = 1/2 (I - F^-T F^-1),
-                    # with F^-1 = J0 J^-1: G = F^-1, eg = 1/2 (I - G^T G).
-                    j0i = jac0_inv[e, p, k]
-                    for i in range(3):
-                        for j in range(3):
-                            acc = 0.0
-                            for m in range(3):
-                                acc += jac[i, m] * j0i[m, j]
-                            L[i, j] = acc  # F
-                    _almansi(L, eg)
-                    _global_to_lamina_strain(eg, q, e5)
-                    for i in range(5):
-                        acc = 0.0
-                        for j in range(5):
-                            acc += C[i, j] * e5[j]
-                        stress[e, p, k, i] = acc
-                _lamina_to_global(stress[e, p, k], q, sg)
-                _accumulate(sg, gN, gM, det * wq[p] * wt[k], fe, ge)
-        for a in range(9):
-            node = conn[e, a]
-            for i in range(3):
-                f[node, i] += fe[a, i]
-                g[node, i] += ge[a, i]
-    _to_rotational(g, d, e1, fr)
+#: Modes of :func:`_element_response`.
+TOTAL, INCREMENTAL, LINEAR = 0, 1, 2
 
 
 @njit(cache=True)
@@ -258,27 +171,178 @@ def _almansi(F, eg):
 
 
 @njit(cache=True)
-def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, C, vu, vr, f, fr):
-    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
+def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz, wt, C, stress, fe, ge, work):
+    """Stresses and nodal forces of one element, with assumed membrane strains.
 
-    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
-    fr (n, 2). Other arguments as :func:`internal_forces`.
+    mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
+    the strain increment of the field ue, ve) or LINEAR (strain of the field ue, ve: the
+    material stiffness product). Points: rows 0..nq-1 of N, dNr, dNs are the 3 x 3 Gauss
+    points, the last 4 rows the 2 x 2 sampling points; L (nq, 4) interpolates bilinearly
+    from the sampling points.
+
+    Assumed membrane strain (against membrane locking: a curved quadratic element cannot
+    bend without stretching by O(theta^2), and 3 x 3 points sample that spurious stretch,
+    which vanishes at the 2 x 2 points): for the in-plane components 11, 22, 12,
+        eps*(p, t) = eps(p, t) - mean_t m(p) + sum_g L_g(p) mean_t m(g),
+    m the in-plane strain as a global tensor, so the through-thickness mean (membrane
+    part) comes from the 2 x 2 points while the deviation (bending part) and the
+    transverse shears come from the point itself. Constant strain and rigid motion are
+    kept exactly. The virtual work sum sigma . delta eps* dv then puts effective stresses
+    at both point sets.
+
+    xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (nq + 4, nt, 3, 3) (TOTAL only);
+    stress (nq, nt, 5) read (INCREMENTAL) and written; fe, ge (9, 3) overwritten;
+    work: scratch from :func:`_scratch`.
     """
+    jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F = work
+    nq = wq.shape[0]
+    npts = N.shape[0]
+    nt = tz.shape[0]
+    wsum = 0.0
+    for k in range(nt):
+        wsum += wt[k]
+    for p in range(npts):
+        for k in range(nt):
+            det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
+            Q[p, k] = q
+            GN[p, k] = gN
+            GM[p, k] = gM
+            DV[p, k] = det * wq[p] * wt[k] if p < nq else 0.0
+            if mode == TOTAL:
+                for i in range(3):
+                    for j in range(3):
+                        acc = 0.0
+                        for m in range(3):
+                            acc += jac[i, m] * jac0_inv[p, k, m, j]
+                        F[i, j] = acc
+                _almansi(F, eg)
+            else:
+                _gradient_of(ue, ve, gN, gM, F)
+                for i in range(3):
+                    for j in range(3):
+                        eg[i, j] = 0.5 * (F[i, j] + F[j, i])
+            _global_to_lamina_strain(eg, q, EPS[p, k])
+    # Membrane parts as global tensors (lamina axes turn from point to point, so lamina
+    # components must not be mixed): m(x, k) = q^T [in-plane part of eps] q, and their
+    # through-thickness means mbar(x).
+    mbar = np.zeros((npts, 3, 3))
+    plane = np.zeros((3, 3))
+    glob = np.empty((3, 3))
+    for x in range(npts):
+        for k in range(nt):
+            plane[0, 0] = EPS[x, k, 0]
+            plane[1, 1] = EPS[x, k, 1]
+            plane[0, 1] = plane[1, 0] = 0.5 * EPS[x, k, 2]
+            _unrotate(Q[x, k], plane, glob)
+            for i in range(3):
+                for j in range(3):
+                    mbar[x, i, j] += wt[k] / wsum * glob[i, j]
+    # eps*(p, k) = eps(p, k) + [in-plane lamina part of (sum_g L_g mbar(g) - mbar(p))]
+    target = np.empty((3, 3))
+    local = np.empty((3, 3))
+    for p in range(nq):
+        for i in range(3):
+            for j in range(3):
+                acc = -mbar[p, i, j]
+                for g in range(4):
+                    acc += L[p, g] * mbar[nq + g, i, j]
+                target[i, j] = acc
+        for k in range(nt):
+            _rotate(Q[p, k], target, local)
+            EPS[p, k, 0] += local[0, 0]
+            EPS[p, k, 1] += local[1, 1]
+            EPS[p, k, 2] += 2.0 * local[0, 1]
+            for i in range(5):
+                acc = 0.0
+                for j in range(5):
+                    acc += C[i, j] * EPS[p, k, j]
+                if mode == INCREMENTAL:
+                    stress[p, k, i] += acc
+                else:
+                    stress[p, k, i] = acc
+    # Virtual work: the direct terms s dv at (p, k); the membrane stresses, gathered as
+    # global tensors B(p) = sum_k dv q^T s_m q, act back through -mbar(p) at the 3 x 3
+    # points and through sum_p L_g(p) B(p) at the 2 x 2 points.
+    B = np.zeros((nq, 3, 3))
+    for p in range(nq):
+        for k in range(nt):
+            plane[0, 0] = stress[p, k, 0] * DV[p, k]
+            plane[1, 1] = stress[p, k, 1] * DV[p, k]
+            plane[0, 1] = plane[1, 0] = stress[p, k, 2] * DV[p, k]
+            _unrotate(Q[p, k], plane, glob)
+            for i in range(3):
+                for j in range(3):
+                    B[p, i, j] += glob[i, j]
+    s5 = np.empty(5)
+    fe[:] = 0.0
+    ge[:] = 0.0
+    for x in range(npts):
+        if x < nq:
+            for i in range(3):
+                for j in range(3):
+                    target[i, j] = -B[x, i, j]
+        else:
+            for i in range(3):
+                for j in range(3):
+                    acc = 0.0
+                    for p in range(nq):
+                        acc += L[p, x - nq] * B[p, i, j]
+                    target[i, j] = acc
+        for k in range(nt):
+            _rotate(Q[x, k], target, local)
+            share = wt[k] / wsum
+            if x < nq:
+                for i in range(5):
+                    s5[i] = stress[x, k, i] * DV[x, k]
+            else:
+                s5[:] = 0.0
+            s5[0] += share * local[0, 0]
+            s5[1] += share * local[1, 1]
+            s5[2] += share * local[0, 1]
+            _lamina_to_global(s5, Q[x, k], sg)
+            _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+
+
+@njit(cache=True)
+def _rotate(q, A, out):
+    """out = q A q^T (global tensor to lamina components), all (3, 3)."""
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                for m in range(3):
+                    acc += q[i, k] * A[k, m] * q[j, m]
+            out[i, j] = acc
+
+
+@njit(cache=True)
+def _unrotate(q, A, out):
+    """out = q^T A q (lamina components to global tensor), all (3, 3)."""
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for k in range(3):
+                for m in range(3):
+                    acc += q[k, i] * A[k, m] * q[m, j]
+            out[i, j] = acc
+
+
+@njit(cache=True)
+def _scratch(npts, nt):
+    """Work arrays of :func:`_element_response`."""
+    return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
+            np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
+            np.empty((npts, nt)), np.empty((npts, nt, 5)), np.empty((3, 3)), np.empty((3, 3)),
+            np.empty((3, 3)))
+
+
+@njit(cache=True)
+def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, stress, f, fr):
+    """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2)."""
     nn = x.shape[0]
-    vd = np.empty((nn, 3))
-    director_increments(vr, d, e1, vd)
     f[:] = 0.0
     g = np.zeros((nn, 3))
-    jac = np.empty((3, 3))
-    jinv = np.empty((3, 3))
-    q = np.empty((3, 3))
-    gN = np.empty((9, 3))
-    gM = np.empty((9, 3))
-    sg = np.empty((3, 3))
-    L = np.empty((3, 3))
-    eg = np.empty((3, 3))
-    e5 = np.empty(5)
-    s5 = np.empty(5)
+    work = _scratch(N.shape[0], tz.shape[0])
     xe = np.empty((9, 3))
     de = np.empty((9, 3))
     he = np.empty(9)
@@ -293,31 +357,54 @@ def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, wq, tz, wt, C, vu, vr, f, 
             for i in range(3):
                 xe[a, i] = x[node, i]
                 de[a, i] = d[node, i]
-                ue[a, i] = vu[node, i]
-                ve[a, i] = vd[node, i]
-        fe[:] = 0.0
-        ge[:] = 0.0
-        for p in range(N.shape[0]):
-            for k in range(tz.shape[0]):
-                det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
-                _gradient_of(ue, ve, gN, gM, L)
-                for i in range(3):
-                    for j in range(3):
-                        eg[i, j] = 0.5 * (L[i, j] + L[j, i])
-                _global_to_lamina_strain(eg, q, e5)
-                for i in range(5):
-                    acc = 0.0
-                    for j in range(5):
-                        acc += C[i, j] * e5[j]
-                    s5[i] = acc
-                _lamina_to_global(s5, q, sg)
-                _accumulate(sg, gN, gM, det * wq[p] * wt[k], fe, ge)
+                ue[a, i] = ux[node, i]
+                ve[a, i] = ud[node, i]
+        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, L, wq, tz, wt, C,
+                          stress[e], fe, ge, work)
         for a in range(9):
             node = conn[e, a]
             for i in range(3):
                 f[node, i] += fe[a, i]
                 g[node, i] += ge[a, i]
     _to_rotational(g, d, e1, fr)
+
+
+@njit(cache=True)
+def internal_forces(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C,
+                    incremental, dx, dd, stress, f, fr):
+    """Internal forces of all elements at the current configuration.
+
+    Parameters
+    ----------
+    x, d : (n, 3) current mid-surface positions and unit directors.
+    h : (n,) fibre lengths. e1 : (n, 3) fibre-frame first axes.
+    conn : (ne, 9). N, dNr, dNs : (nq + 4, 9) shape functions and derivatives at the 3 x 3
+        integration points and the 2 x 2 sampling points; L (nq, 4) bilinear interpolation
+        from the sampling points; wq (nq,). tz, wt : (nt,) thickness points and weights.
+    jac0_inv : (ne, nq + 4, nt, 3, 3) inverse reference Jacobians (total formulation).
+    C : (5, 5) reduced lamina constitutive matrix.
+    incremental : False for the total formulation (stress from the total deformation,
+        Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
+        in the lamina frame plus C~ times the strain increment of the last step, Eq 3.2).
+    dx, dd : (n, 3) last step's mid-surface and director increments (incremental only).
+    stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
+    f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
+    """
+    _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, L,
+                  wq, tz, wt, jac0_inv, C, stress, f, fr)
+
+
+@njit(cache=True)
+def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, vu, vr, f, fr):
+    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
+
+    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
+    fr (n, 2). Other arguments as :func:`internal_forces`.
+    """
+    vd = np.empty((x.shape[0], 3))
+    director_increments(vr, d, e1, vd)
+    stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
+    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, stress, f, fr)
 
 
 @njit(cache=True)
@@ -352,7 +439,7 @@ def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, m
         raw[:] = 0.0
         rot[:] = 0.0
         volume = 0.0
-        for p in range(N.shape[0]):
+        for p in range(wq.shape[0]):
             for k in range(tz.shape[0]):
                 det = _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
                 dv = det * wq[p] * wt[k]
@@ -396,7 +483,7 @@ def pressure_forces(x, d, h, conn, elements, face, scale, N, dNr, dNs, wq, f, g)
         e = elements[m]
         t = float(face[m])
         sign = -1.0 if face[m] > 0 else 1.0
-        for p in range(N.shape[0]):
+        for p in range(wq.shape[0]):
             yr[:] = 0.0
             ys[:] = 0.0
             for a in range(9):

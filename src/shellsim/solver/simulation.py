@@ -54,7 +54,7 @@ class Simulation:
 
     def __init__(self, model: Model):
         self.model = model
-        n, ne, nq, nt = model.n_nodes, model.n_elements, len(model.N), len(model.tz)
+        n, ne, nq, nt = model.n_nodes, model.n_elements, len(model.wq), len(model.tz)
         self.state = State(
             t=0.0, x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy(),
             v=np.zeros((n, 3)), w=np.zeros((n, 2)), theta=np.zeros((n, 2)),
@@ -79,7 +79,7 @@ class Simulation:
 
     def _arguments(self) -> tuple:
         m, s = self.model, self.state
-        return (m.conn, m.N, m.dNr, m.dNs, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.incremental, s.stress,
+        return (m.conn, m.N, m.dNr, m.dNs, m.L, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.incremental, s.stress,
                 m.dead_force, m.dead_moment, m.dead_curve, m.pressure_elements, m.pressure_face,
                 m.pressure_value, m.pressure_curve, m.edge_pressure_edges, m.edge_pressure_outward,
                 m.edge_pressure_value, m.edge_pressure_curve, m.curve_t, m.curve_v, m.curve_len,

@@ -28,28 +28,31 @@ def normalize(a: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def lamina_frame(g_r: np.ndarray, g_s: np.ndarray, q: np.ndarray) -> None:
-    """Hughes' lamina basis at a point from the tangents g_r = dy/dr, g_s = dy/ds (3,).
+def lamina_frame(jac: np.ndarray, q: np.ndarray) -> None:
+    """Hughes' lamina basis at a point from the tangents g_r = jac[:, 0], g_s = jac[:, 1].
 
     e3 is the lamina normal; e1, e2 lie in the lamina, symmetric about the bisector of
     e_r and e_s (thesis Eq 2.57 and Figure 2.11). Writes q (3, 3) with rows e1, e2, e3
-    (the global -> lamina rotation [q]).
+    (the global -> lamina rotation [q]). Scalar arithmetic only: it runs at every
+    integration point of every step.
     """
-    er = g_r / np.sqrt(g_r @ g_r)
-    es = g_s / np.sqrt(g_s @ g_s)
-    e3 = np.empty(3)
-    cross(er, es, e3)
-    normalize(e3)
-    ea = er + es
-    normalize(ea)
-    eb = np.empty(3)
-    cross(e3, ea, eb)
-    normalize(eb)
+    nr = np.sqrt(jac[0, 0] ** 2 + jac[1, 0] ** 2 + jac[2, 0] ** 2)
+    ns = np.sqrt(jac[0, 1] ** 2 + jac[1, 1] ** 2 + jac[2, 1] ** 2)
+    rx, ry, rz = jac[0, 0] / nr, jac[1, 0] / nr, jac[2, 0] / nr
+    sx, sy, sz = jac[0, 1] / ns, jac[1, 1] / ns, jac[2, 1] / ns
+    nx, ny, nz = ry * sz - rz * sy, rz * sx - rx * sz, rx * sy - ry * sx
+    n = np.sqrt(nx * nx + ny * ny + nz * nz)
+    nx, ny, nz = nx / n, ny / n, nz / n
+    ax, ay, az = rx + sx, ry + sy, rz + sz
+    a = np.sqrt(ax * ax + ay * ay + az * az)
+    ax, ay, az = ax / a, ay / a, az / a
+    bx, by, bz = ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
+    b = np.sqrt(bx * bx + by * by + bz * bz)
+    bx, by, bz = bx / b, by / b, bz / b
     c = np.sqrt(0.5)
-    for i in range(3):
-        q[0, i] = c * (ea[i] - eb[i])
-        q[1, i] = c * (ea[i] + eb[i])
-        q[2, i] = e3[i]
+    q[0, 0], q[0, 1], q[0, 2] = c * (ax - bx), c * (ay - by), c * (az - bz)
+    q[1, 0], q[1, 1], q[1, 2] = c * (ax + bx), c * (ay + by), c * (az + bz)
+    q[2, 0], q[2, 1], q[2, 2] = nx, ny, nz
 
 
 @njit(cache=True)

@@ -60,7 +60,7 @@ def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
     jinv[2, 0] = (jac[1, 0] * jac[2, 1] - jac[1, 1] * jac[2, 0]) / det
     jinv[2, 1] = (jac[0, 1] * jac[2, 0] - jac[0, 0] * jac[2, 1]) / det
     jinv[2, 2] = (jac[0, 0] * jac[1, 1] - jac[0, 1] * jac[1, 0]) / det
-    lamina_frame(jac[:, 0].copy(), jac[:, 1].copy(), q)
+    lamina_frame(jac, q)
     for a in range(9):
         half = 0.5 * he[a]
         for j in range(3):
@@ -72,38 +72,28 @@ def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
 @njit(cache=True)
 def _lamina_to_global(s5, q, sg):
     """Global stress sg (3, 3) = q^T sigma^l q from lamina (s11, s22, s12, s13, s23)."""
-    sl = np.empty((3, 3))
-    sl[0, 0] = s5[0]
-    sl[1, 1] = s5[1]
-    sl[2, 2] = 0.0
-    sl[0, 1] = sl[1, 0] = s5[2]
-    sl[0, 2] = sl[2, 0] = s5[3]
-    sl[1, 2] = sl[2, 1] = s5[4]
     for i in range(3):
+        # row i of q^T sigma^l: sum_k q[k, i] sigma^l[k, :]
+        t0 = q[0, i] * s5[0] + q[1, i] * s5[2] + q[2, i] * s5[3]
+        t1 = q[0, i] * s5[2] + q[1, i] * s5[1] + q[2, i] * s5[4]
+        t2 = q[0, i] * s5[3] + q[1, i] * s5[4]
         for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                for m in range(3):
-                    acc += q[k, i] * sl[k, m] * q[m, j]
-            sg[i, j] = acc
+            sg[i, j] = t0 * q[0, j] + t1 * q[1, j] + t2 * q[2, j]
 
 
 @njit(cache=True)
-def _global_to_lamina_strain(eg, q, e5):
-    """Lamina strain vector (e11, e22, 2e12, 2e13, 2e23) of q eg q^T, eg (3, 3) symmetric."""
-    el = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                for m in range(3):
-                    acc += q[i, k] * eg[k, m] * q[j, m]
-            el[i, j] = acc
-    e5[0] = el[0, 0]
-    e5[1] = el[1, 1]
-    e5[2] = 2.0 * el[0, 1]
-    e5[3] = 2.0 * el[0, 2]
-    e5[4] = 2.0 * el[1, 2]
+def _global_to_lamina_strain(eg, q, e5, v):
+    """Lamina strain vector (e11, e22, 2e12, 2e13, 2e23) of q eg q^T, eg (3, 3) symmetric;
+    v (3, 3) scratch."""
+    # rows of eg q^T, i.e. (eg q_a) for lamina axes a = 0, 1, 2
+    for a in range(3):
+        for i in range(3):
+            v[a, i] = eg[i, 0] * q[a, 0] + eg[i, 1] * q[a, 1] + eg[i, 2] * q[a, 2]
+    e5[0] = q[0, 0] * v[0, 0] + q[0, 1] * v[0, 1] + q[0, 2] * v[0, 2]
+    e5[1] = q[1, 0] * v[1, 0] + q[1, 1] * v[1, 1] + q[1, 2] * v[1, 2]
+    e5[2] = 2.0 * (q[0, 0] * v[1, 0] + q[0, 1] * v[1, 1] + q[0, 2] * v[1, 2])
+    e5[3] = 2.0 * (q[0, 0] * v[2, 0] + q[0, 1] * v[2, 1] + q[0, 2] * v[2, 2])
+    e5[4] = 2.0 * (q[1, 0] * v[2, 0] + q[1, 1] * v[2, 1] + q[1, 2] * v[2, 2])
 
 
 @njit(cache=True)
@@ -155,10 +145,13 @@ TOTAL, INCREMENTAL, LINEAR = 0, 1, 2
 
 
 @njit(cache=True)
-def _almansi(F, eg):
-    """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3).
-    A degenerate F gives non-finite values (no exception), which the time loop detects."""
-    B = F @ F.T
+def _almansi(F, eg, B):
+    """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3); B (3, 3)
+    scratch. A degenerate F gives non-finite values (no exception), which the time loop
+    detects."""
+    for i in range(3):
+        for j in range(i, 3):
+            B[i, j] = B[j, i] = F[i, 0] * F[j, 0] + F[i, 1] * F[j, 1] + F[i, 2] * F[j, 2]
     det = (B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1])
            - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
            + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0]))
@@ -194,7 +187,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
     stress (nq, nt, 5) read (INCREMENTAL) and written; fe, ge (9, 3) overwritten;
     work: scratch from :func:`_scratch`.
     """
-    jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F = work
+    jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, mbar, B, plane, glob, target, local, s5, v = work
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -215,19 +208,18 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
                         for m in range(3):
                             acc += jac[i, m] * jac0_inv[p, k, m, j]
                         F[i, j] = acc
-                _almansi(F, eg)
+                _almansi(F, eg, v)
             else:
                 _gradient_of(ue, ve, gN, gM, F)
                 for i in range(3):
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
-            _global_to_lamina_strain(eg, q, EPS[p, k])
+            _global_to_lamina_strain(eg, q, EPS[p, k], v)
     # Membrane parts as global tensors (lamina axes turn from point to point, so lamina
     # components must not be mixed): m(x, k) = q^T [in-plane part of eps] q, and their
     # through-thickness means mbar(x).
-    mbar = np.zeros((npts, 3, 3))
-    plane = np.zeros((3, 3))
-    glob = np.empty((3, 3))
+    mbar[:] = 0.0
+    plane[:] = 0.0
     for x in range(npts):
         for k in range(nt):
             plane[0, 0] = EPS[x, k, 0]
@@ -238,8 +230,6 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
                 for j in range(3):
                     mbar[x, i, j] += wt[k] / wsum * glob[i, j]
     # eps*(p, k) = eps(p, k) + [in-plane lamina part of (sum_g L_g mbar(g) - mbar(p))]
-    target = np.empty((3, 3))
-    local = np.empty((3, 3))
     for p in range(nq):
         for i in range(3):
             for j in range(3):
@@ -263,7 +253,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
     # Virtual work: the direct terms s dv at (p, k); the membrane stresses, gathered as
     # global tensors B(p) = sum_k dv q^T s_m q, act back through -mbar(p) at the 3 x 3
     # points and through sum_p L_g(p) B(p) at the 2 x 2 points.
-    B = np.zeros((nq, 3, 3))
+    B[:] = 0.0
     for p in range(nq):
         for k in range(nt):
             plane[0, 0] = stress[p, k, 0] * DV[p, k]
@@ -273,7 +263,6 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
             for i in range(3):
                 for j in range(3):
                     B[p, i, j] += glob[i, j]
-    s5 = np.empty(5)
     fe[:] = 0.0
     ge[:] = 0.0
     for x in range(npts):
@@ -333,7 +322,8 @@ def _scratch(npts, nt):
     return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
             np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
             np.empty((npts, nt)), np.empty((npts, nt, 5)), np.empty((3, 3)), np.empty((3, 3)),
-            np.empty((3, 3)))
+            np.empty((3, 3)), np.empty((npts, 3, 3)), np.empty((npts - 4, 3, 3)), np.empty((3, 3)),
+            np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty(5), np.empty((3, 3)))
 
 
 @njit(cache=True)

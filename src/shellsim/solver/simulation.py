@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..element import kernels
+from ..errors import NumericalError
 from ..model import Model
 from . import explicit
 from .timestep import critical_time_step
@@ -94,11 +95,20 @@ class Simulation:
     def advance(self, t_stop: float, dt: float, max_steps: int) -> int:
         """Step with ``dt`` until ``t_stop`` (landing on it) or ``max_steps``; returns the
         number of steps taken."""
+        s = self.state
+        try:
+            s.t, s.dt_prev, steps = self._advance(t_stop, dt, max_steps)
+        except (ZeroDivisionError, FloatingPointError) as error:
+            # a director or frame collapsed: the state has degenerated beyond recovery
+            raise NumericalError(f"the run broke down at t = {s.t:.6g} after {s.steps} steps: "
+                                 f"a degenerate state ({error}); the motion had become unstable") from None
+        s.steps += steps
+        return steps
+
+    def _advance(self, t_stop: float, dt: float, max_steps: int) -> tuple[float, float, int]:
         m, s = self.model, self.state
-        s.t, s.dt_prev, steps = explicit.advance(
+        return explicit.advance(
             s.t, t_stop, max_steps, dt, s.dt_prev, s.x, m.x0, s.d, s.e1, s.h, s.v, s.w, s.theta,
             s.mt, s.mr, m.projector, m.rot_free, m.prescribed_nodes, m.prescribed_axes,
             m.prescribed_values, m.prescribed_curves, s.prescribed_velocity, m.damping,
             *self._arguments(), s.f_int, s.fr_int, s.f_ext, s.fr_ext, s.work, s.energy)
-        s.steps += steps
-        return steps

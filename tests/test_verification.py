@@ -18,6 +18,8 @@ from .conftest import ROOT
 DECKS = [
     "test02_cantilever_uniform_load_3.toml",
     "test03_strip_moment_irregular3.toml",
+    "test05_scordelis_lo_6x6.toml",
+    "test06_twisted_beam_8_inplane.toml",
 ]
 
 

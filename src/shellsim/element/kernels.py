@@ -225,7 +225,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
             plane[0, 0] = EPS[x, k, 0]
             plane[1, 1] = EPS[x, k, 1]
             plane[0, 1] = plane[1, 0] = 0.5 * EPS[x, k, 2]
-            _unrotate(Q[x, k], plane, glob)
+            _rotate(Q[x, k].T, plane, glob)
             for i in range(3):
                 for j in range(3):
                     mbar[x, i, j] += wt[k] / wsum * glob[i, j]
@@ -259,7 +259,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
             plane[0, 0] = stress[p, k, 0] * DV[p, k]
             plane[1, 1] = stress[p, k, 1] * DV[p, k]
             plane[0, 1] = plane[1, 0] = stress[p, k, 2] * DV[p, k]
-            _unrotate(Q[p, k], plane, glob)
+            _rotate(Q[p, k].T, plane, glob)
             for i in range(3):
                 for j in range(3):
                     B[p, i, j] += glob[i, j]
@@ -294,25 +294,14 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
 
 @njit(cache=True)
 def _rotate(q, A, out):
-    """out = q A q^T (global tensor to lamina components), all (3, 3)."""
+    """out = q A q^T, all (3, 3): global tensor to lamina components with q, and back with
+    q.T."""
     for i in range(3):
         for j in range(3):
             acc = 0.0
             for k in range(3):
                 for m in range(3):
                     acc += q[i, k] * A[k, m] * q[j, m]
-            out[i, j] = acc
-
-
-@njit(cache=True)
-def _unrotate(q, A, out):
-    """out = q^T A q (lamina components to global tensor), all (3, 3)."""
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                for m in range(3):
-                    acc += q[k, i] * A[k, m] * q[m, j]
             out[i, j] = acc
 
 

@@ -22,7 +22,7 @@ def test_help_lists_every_command():
 
 
 @pytest.mark.parametrize("args", [["run", str(DEFAULT_DECK)], ["render", "results"],
-                                  ["report", "study.toml"], ["bench"]])
+                                  ["report", "study.toml"]])
 def test_commands_still_to_come_say_so_and_fail(args):
     result = runner.invoke(app, args)
     assert result.exit_code == 2

@@ -203,9 +203,30 @@ def report(study: Annotated[Path, typer.Argument(help="A study (TOML).")]) -> No
 
 @app.command()
 @reports_errors
-def bench() -> None:
-    """Measure speed: microseconds per element per step, GFLOP/s."""
-    _not_yet("'shellsim bench' (solver benchmarks)")
+def bench(
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Also write bench.json here.")] = None,
+) -> None:
+    """Measure speed: microseconds per element per step and GFLOP/s of the element kernel
+    (Scordelis-Lo 16 x 16), and the bench plate's error and wall time per mesh."""
+    from .bench import kernel_speed, plate_ladder
+
+    kernel = kernel_speed()
+    out.print(f"kernel (Scordelis-Lo, {kernel['elements']} elements, {kernel['steps']} steps): "
+              f"{kernel['us_per_element_step']:.2f} us per element-step, "
+              f"{kernel['flops_per_element_step']:,} flop per element-step, {kernel['gflops']:.2f} GFLOP/s")
+    ladder = plate_ladder()
+    table = Table(title="bench plate (decks/bench/plate_step.toml): first peak", title_justify="left")
+    for column in ("mesh", "elements", "steps", "wall time [s]", "us/element-step", "peak error", "peak time error"):
+        table.add_column(column)
+    for row in ladder:
+        table.add_row(row["mesh"], str(row["elements"]), str(row["steps"]), f"{row['wall_time_s']:.2f}",
+                      f"{row['us_per_element_step']:.2f}", f"{row['peak_error_percent']:+.3f}%",
+                      f"{row['peak_time_error_percent']:+.3f}%")
+    out.print(table)
+    if out_dir is not None:
+        from .output.summary import write_json
+
+        write_json({"kernel": kernel, "plate": ladder}, _output_folder(out_dir) / "bench.json")
 
 
 def _output_folder(path: Path) -> Path:

@@ -1,0 +1,77 @@
+"""Speed, measured: the element kernel on the Scordelis-Lo 16 x 16 mesh (microseconds per
+element per step, GFLOP/s from the operation count below) and the peer-comparison plate
+(decks/bench/plate_step.toml) on a ladder of meshes (error of the first peak, wall time).
+Nothing here asserts a time; it reports."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .deck import parse_deck
+from .geometry import build_mesh
+from .model import build_model
+from .solver.run import integrate, prepare
+from .solver.simulation import Simulation
+from .verify.check import check
+
+DECKS = Path(__file__).resolve().parents[2] / "decks"
+
+
+def flops_per_element(n_thick: int = 2) -> int:
+    """Floating-point operations (additions, multiplications, divisions, square roots; a
+    fused multiply-add counts 2) of one element's internal force in the total formulation,
+    counted from :func:`shellsim.element.kernels._element_response`.
+
+    Per point (13 in-plane points: 9 integration + 4 membrane sampling, times n_thick):
+      geometry: Jacobian 252, determinant 14, inverse 36, lamina frame 60, gradient
+      vectors gN, gM 198 -> 560; total Almansi strain: F 45, inverse of F F^T 80,
+      rotation to the lamina 70 -> 195; membrane part as a global tensor 162 + mean 18.
+    Per integration point (9 x n_thick): assumed-strain correction 162 + 3, stress 50,
+      gathering B 174.
+    Per in-plane integration point: the interpolation target 81.
+    Per point for the forces: rotation 162, effective stress 11, to global 54, gather
+      into the nine nodes 324 -> 551; per sampling point the interpolated target 162.
+    """
+    points, integration = 13 * n_thick, 9 * n_thick
+    per_point = 560 + 195 + 180 + 551
+    return points * per_point + integration * (165 + 50 + 174) + 9 * 81 + 4 * 162
+
+
+def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:
+    """Microseconds per element per step of the full time step (forces, update) on the
+    Scordelis-Lo roof with ``divisions`` x ``divisions`` elements."""
+    text = (DECKS / "verification" / "test05_scordelis_lo_6x6.toml").read_text()
+    deck = parse_deck(text.replace("around = 6, along = 6", f"around = {divisions}, along = {divisions}"))
+    sim = Simulation(build_model(deck, build_mesh(deck)))
+    dt = sim.critical_time_step() / 1.25
+    sim.advance(10 * dt, dt, 10)  # compile and warm up
+    start = time.perf_counter()
+    taken = sim.advance(sim.state.t + steps * dt, dt, steps)
+    seconds = time.perf_counter() - start
+    ne = sim.model.n_elements
+    us = 1e6 * seconds / (taken * ne)
+    flops = flops_per_element(len(sim.model.tz))
+    return {"elements": ne, "steps": taken, "us_per_element_step": us,
+            "flops_per_element_step": flops, "gflops": flops / (us * 1e3)}
+
+
+def plate_ladder(divisions=(2, 4, 8)) -> list[dict]:
+    """The bench plate per mesh: first-peak error, wall time of the run to t = 0.18 s."""
+    text = (DECKS / "bench" / "plate_step.toml").read_text()
+    rows = []
+    for n in divisions:
+        deck = parse_deck(text.replace("length = 2, width = 2", f"length = {n}, width = {n}"))
+        mesh = build_mesh(deck)
+        run = integrate(prepare(deck, mesh, build_model(deck, mesh)))
+        times = np.asarray(run.times)
+        results = {r.measure: check(r, times, np.asarray(run.history[r.probe])) for r in deck.reference}
+        rows.append({
+            "mesh": f"{n}x{n}", "elements": mesh.n_elements, "steps": run.sim.state.steps,
+            "wall_time_s": run.wall_time, "peak_error_percent": results["min"]["error_percent"],
+            "peak_time_error_percent": results["first_peak_time"]["error_percent"],
+            "us_per_element_step": 1e6 * run.wall_time / (run.sim.state.steps * mesh.n_elements),
+        })
+    return rows

@@ -16,6 +16,7 @@ from shellsim.verify.check import check
 from .conftest import ROOT
 
 DECKS = [
+    "test01_nafems_21t_4x4.toml",
     "test02_cantilever_uniform_load_3.toml",
     "test03_strip_moment_irregular3.toml",
     "test05_scordelis_lo_6x6.toml",

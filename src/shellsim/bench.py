@@ -25,19 +25,19 @@ def flops_per_element(n_thick: int = 2) -> int:
     fused multiply-add counts 2) of one element's internal force in the total formulation,
     counted from :func:`shellsim.element.kernels._element_response`.
 
-    Per point (13 in-plane points: 9 integration + 4 membrane sampling, times n_thick):
+    Per point (25 in-plane points: 9 integration + 16 membrane tying points, times n_thick):
       geometry: Jacobian 252, determinant 14, inverse 36, lamina frame 60, gradient
       vectors gN, gM 198 -> 560; total Almansi strain: F 45, inverse of F F^T 80,
-      rotation to the lamina 70 -> 195; membrane part as a global tensor 162 + mean 18.
-    Per integration point (9 x n_thick): assumed-strain correction 162 + 3, stress 50,
-      gathering B 174.
-    Per in-plane integration point: the interpolation target 81.
-    Per point for the forces: rotation 162, effective stress 11, to global 54, gather
-      into the nine nodes 324 -> 551; per sampling point the interpolated target 162.
+      rotation to the lamina 70 -> 195; covariant membrane strains: in-plane tensor 165,
+      three contractions 81, mean 6 -> 252; forces: tying terms 108, gather into the nine
+      nodes 324 -> 432.
+    Per integration point and thickness point (9 x n_thick): tensor from the covariant
+      change 90, rotation 165, stress 50 -> 305; gathering the contravariant stresses 228;
+      lamina stress to global 59.
+    Per in-plane integration point: tying interpolations 36 and their adjoint 39.
     """
-    points, integration = 13 * n_thick, 9 * n_thick
-    per_point = 560 + 195 + 180 + 551
-    return points * per_point + integration * (165 + 50 + 174) + 9 * 81 + 4 * 162
+    points, integration = 25 * n_thick, 9 * n_thick
+    return points * (560 + 195 + 252 + 432) + integration * (305 + 228 + 59) + 9 * (36 + 39)
 
 
 def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:

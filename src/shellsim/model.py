@@ -32,10 +32,10 @@ class Model:
 
     x0, d0 [n, 3]: initial mid-surface and directors; h0 [n]: fibre lengths;
     e1f0 [n, 3]: initial fibre-frame first axes; conn [ne, 9].
-    N, dNr, dNs [nq + 4, 9]: shape functions at the 3 x 3 integration points and the
-    2 x 2 membrane sampling points; L [nq, 4]: interpolation from the latter; wq [nq]:
-    in-plane weights; tz, wt [nt]: thickness rule.
-    jac0_inv [ne, nq + 4, nt, 3, 3]: inverse initial Jacobians.
+    N, dNr, dNs [25, 9]: shape functions at the 3 x 3 integration points and the
+    membrane tying points; tie [3, nq, 6], tie_points [3, 6]: the tying interpolation;
+    wq [nq]: in-plane weights; tz, wt [nt]: thickness rule.
+    jac0_inv [ne, 25, nt, 3, 3]: inverse initial Jacobians.
     C [5, 5]: reduced lamina matrix; density; mass 'M1'/'M2'; damping [1/s].
     projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
     prescribed_*: nodes, axes, values, curves of prescribed translations.
@@ -53,7 +53,8 @@ class Model:
     N: np.ndarray
     dNr: np.ndarray
     dNs: np.ndarray
-    L: np.ndarray
+    tie: np.ndarray
+    tie_points: np.ndarray
     wq: np.ndarray
     tz: np.ndarray
     wt: np.ndarray
@@ -96,23 +97,49 @@ class Model:
 
 
 def integration_rule(points_through_thickness: int):
-    """(N, dNr, dNs, L, wq, tz, wt) of the element.
+    """(N, dNr, dNs, tie, tie_points, wq, tz, wt) of the element.
 
-    N, dNr, dNs (13, 9): shape functions and derivatives at the 3 x 3 Gauss points
-    (rows 0-8, thesis 3.15) followed by the 2 x 2 Gauss points (rows 9-12) where membrane
-    strains are sampled; L (9, 4): bilinear interpolation from the 2 x 2 points to the
-    3 x 3 ones; wq (9,): in-plane weights; tz, wt: ``points_through_thickness`` Gauss
-    points and weights through the thickness.
+    N, dNr, dNs (25, 9): shape functions and derivatives at the 3 x 3 Gauss points (rows
+    0-8, thesis 3.15) and at the membrane tying points (rows 9-24): 2 x 3 points
+    (r = +-1/sqrt 3, s on the 3-point rule) for the covariant strain c_rr, 3 x 2 for c_ss
+    and 2 x 2 for c_rs. tie (3, 9, 6): weights interpolating each component at the
+    integration points from its tying points, Lagrange linear along the 2-point direction
+    and quadratic along the 3-point one; tie_points (3, 6): their row numbers (rs uses 4;
+    the rest carry weight 0). wq (9,): in-plane weights; tz, wt: thickness rule.
     """
     rs, wq = gauss_rule_2d(3)
-    sampling, _ = gauss_rule_2d(2)
-    points = np.vstack([rs, sampling])
+    g2, _ = gauss_rule(2)
+    g3, _ = gauss_rule(3)
+    sets = [
+        [(r, s) for s in g3 for r in g2],  # c_rr: 2 along r, 3 along s
+        [(r, s) for s in g2 for r in g3],  # c_ss: 3 along r, 2 along s
+        [(r, s) for s in g2 for r in g2],  # c_rs: 2 x 2
+    ]
+    points = [rs]
+    tie = np.zeros((3, len(rs), 6))
+    tie_points = np.zeros((3, 6), dtype=np.int64)
+    row = len(rs)
+    for c, tying in enumerate(sets):
+        tying = np.asarray(tying)
+        points.append(tying)
+        tie_points[c, :len(tying)] = np.arange(row, row + len(tying))
+        row += len(tying)
+        for m, (rm, sm) in enumerate(tying):
+            tie[c, :, m] = _lagrange(rs[:, 0], rm, np.unique(tying[:, 0])) * _lagrange(rs[:, 1], sm, np.unique(tying[:, 1]))
+    points = np.vstack(points)
     dN = shape_derivatives(points)
-    # L_g(r, s) = (1 + r / r_g)(1 + s / s_g) / 4 is 1 at sampling point g, 0 at the others
-    L = 0.25 * (1 + rs[:, None, 0] / sampling[None, :, 0]) * (1 + rs[:, None, 1] / sampling[None, :, 1])
     tz, wt = gauss_rule(points_through_thickness)
     return (shape(points), np.ascontiguousarray(dN[:, :, 0]), np.ascontiguousarray(dN[:, :, 1]),
-            L, wq, tz, wt)
+            tie, tie_points, wq, tz, wt)
+
+
+def _lagrange(x: np.ndarray, node: float, nodes: np.ndarray) -> np.ndarray:
+    """The Lagrange polynomial on ``nodes`` that is 1 at ``node``, at x."""
+    out = np.ones_like(x)
+    for other in nodes:
+        if other != node:
+            out *= (x - other) / (node - other)
+    return out
 
 
 def build_model(deck: Deck, mesh: Mesh) -> Model:
@@ -121,7 +148,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     if material.model != "linear_elastic":
         raise NotYetAvailable(f"material.model = '{material.model}' needs the large-strain "
                               "constitutive laws, which are not available yet")
-    N, dNr, dNs, L, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
+    N, dNr, dNs, tie, tie_points, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
     C = reduced_lamina_matrix(material.E, material.nu, deck.section.plane_strain)
     jac0_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)
     projector, rot_free, e1f0, prescribed = _boundary_conditions(deck, mesh)
@@ -130,7 +157,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     tables = _curve_tables(deck, curve_names)
     return Model(
         x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
-        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, L=L, wq=wq, tz=tz, wt=wt,
+        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, tie=tie, tie_points=tie_points, wq=wq, tz=tz, wt=wt,
         jac0_inv=jac0_inv, C=C, density=material.density, mass=deck.solver.mass,
         damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
         projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,

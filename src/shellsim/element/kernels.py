@@ -164,30 +164,35 @@ def _almansi(F, eg, B):
 
 
 @njit(cache=True)
-def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz, wt, C, stress, fe, ge, work):
+def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, stress, fe, ge, work):
     """Stresses and nodal forces of one element, with assumed membrane strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
     the strain increment of the field ue, ve) or LINEAR (strain of the field ue, ve: the
     material stiffness product). Points: rows 0..nq-1 of N, dNr, dNs are the 3 x 3 Gauss
-    points, the last 4 rows the 2 x 2 sampling points; L (nq, 4) interpolates bilinearly
-    from the sampling points.
+    points, the remaining rows the membrane tying points; tie (3, nq, m) and tie_points
+    (3, m) give, for the covariant components rr, ss and rs, the interpolation weights at
+    each integration point and the tying points they refer to.
 
-    Assumed membrane strain (against membrane locking: a curved quadratic element cannot
-    bend without stretching by O(theta^2), and 3 x 3 points sample that spurious stretch,
-    which vanishes at the 2 x 2 points): for the in-plane components 11, 22, 12,
-        eps*(p, t) = eps(p, t) - mean_t m(p) + sum_g L_g(p) mean_t m(g),
-    m the in-plane strain as a global tensor, so the through-thickness mean (membrane
-    part) comes from the 2 x 2 points while the deviation (bending part) and the
-    transverse shears come from the point itself. Constant strain and rigid motion are
-    kept exactly. The virtual work sum sigma . delta eps* dv then puts effective stresses
-    at both point sets.
+    Assumed membrane strain against membrane locking (a curved quadratic element cannot
+    bend without stretching by O(theta^2), which full integration samples): the covariant
+    membrane strains c_ab = g_a . eps . g_b, averaged through the thickness, are tied at
+    points where that spurious stretch vanishes, each component on its own set
+    (rr: 2 x 3, ss: 3 x 2, rs: 2 x 2, as in Huang and Hinton's and Bathe's MITC9 9-node
+    shells; one shared 2 x 2 set would leave three zero-energy membrane modes):
+        c*_ab(p, t) = c_ab(p, t) - cbar_ab(p) + sum_m tie_ab(p, m) cbar_ab(m),
+    and the change goes back into the lamina strains through the contravariant basis. The
+    bending part (the deviation through the thickness) and the transverse shears stay
+    at the point. Constant strain on straight-edged elements and rigid motion are
+    reproduced exactly; the virtual work of sigma . delta eps* puts effective stresses at
+    the tying points too.
 
-    xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (nq + 4, nt, 3, 3) (TOTAL only);
+    xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3) (TOTAL only);
     stress (nq, nt, 5) read (INCREMENTAL) and written; fe, ge (9, 3) overwritten;
     work: scratch from :func:`_scratch`.
     """
-    jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, mbar, B, plane, glob, target, local, s5, v = work
+    (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
+     local, s5, v, cov, delta) = work
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -200,6 +205,10 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
             Q[p, k] = q
             GN[p, k] = gN
             GM[p, k] = gM
+            jinv_all[p, k] = jinv
+            for i in range(3):
+                G[p, k, 0, i] = jac[i, 0]
+                G[p, k, 1, i] = jac[i, 1]
             DV[p, k] = det * wq[p] * wt[k] if p < nq else 0.0
             if mode == TOTAL:
                 for i in range(3):
@@ -215,30 +224,28 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
             _global_to_lamina_strain(eg, q, EPS[p, k], v)
-    # Membrane parts as global tensors (lamina axes turn from point to point, so lamina
-    # components must not be mixed): m(x, k) = q^T [in-plane part of eps] q, and their
-    # through-thickness means mbar(x).
-    mbar[:] = 0.0
-    plane[:] = 0.0
+    # Covariant membrane strains c_ab = g_a . eps . g_b (a, b in r, s), frame-free, and their
+    # through-thickness means cbar (the membrane part), at every point.
+    cbar[:] = 0.0
     for x in range(npts):
         for k in range(nt):
-            plane[0, 0] = EPS[x, k, 0]
-            plane[1, 1] = EPS[x, k, 1]
-            plane[0, 1] = plane[1, 0] = 0.5 * EPS[x, k, 2]
-            _rotate(Q[x, k].T, plane, glob)
-            for i in range(3):
-                for j in range(3):
-                    mbar[x, i, j] += wt[k] / wsum * glob[i, j]
-    # eps*(p, k) = eps(p, k) + [in-plane lamina part of (sum_g L_g mbar(g) - mbar(p))]
+            _lamina_strain_tensor(EPS[x, k], Q[x, k], plane, glob)
+            _covariant(glob, G[x, k], cov)
+            for c in range(3):
+                cbar[x, c] += wt[k] / wsum * cov[c]
+    # Assumed: c*_ab(p, t) = c_ab(p, t) - cbar_ab(p) + [tied cbar_ab at p], each component
+    # interpolated from its own tying points (rr: 2 x 3, ss: 3 x 2, rs: 2 x 2); the change
+    # goes back to a tensor with the contravariant basis and into the lamina strains.
     for p in range(nq):
-        for i in range(3):
-            for j in range(3):
-                acc = -mbar[p, i, j]
-                for g in range(4):
-                    acc += L[p, g] * mbar[nq + g, i, j]
-                target[i, j] = acc
+        for c in range(3):
+            acc = -cbar[p, c]
+            for m in range(tie.shape[2]):
+                if tie[c, p, m] != 0.0:
+                    acc += tie[c, p, m] * cbar[tie_points[c, m], c]
+            delta[c] = acc
         for k in range(nt):
-            _rotate(Q[p, k], target, local)
+            _contravariant_tensor(delta, jinv_all[p, k], glob)
+            _rotate(Q[p, k], glob, local)
             EPS[p, k, 0] += local[0, 0]
             EPS[p, k, 1] += local[1, 1]
             EPS[p, k, 2] += 2.0 * local[0, 1]
@@ -250,46 +257,89 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, L, wq, tz
                     stress[p, k, i] += acc
                 else:
                     stress[p, k, i] = acc
-    # Virtual work: the direct terms s dv at (p, k); the membrane stresses, gathered as
-    # global tensors B(p) = sum_k dv q^T s_m q, act back through -mbar(p) at the 3 x 3
-    # points and through sum_p L_g(p) B(p) at the 2 x 2 points.
-    B[:] = 0.0
+    # Virtual work: the direct terms s dv at (p, k). The in-plane stresses, contracted
+    # with the contravariant basis, Bab(p) = sum_k dv g^a . sigma_m . g^b (twice for rs),
+    # act back through -cbar(p) at the integration points and through the tying at the
+    # tying points, as the global stress (w_k / W) sum_ab T_ab sym(g_a (x) g_b).
+    Bab[:] = 0.0
     for p in range(nq):
         for k in range(nt):
+            plane[:] = 0.0
             plane[0, 0] = stress[p, k, 0] * DV[p, k]
             plane[1, 1] = stress[p, k, 1] * DV[p, k]
             plane[0, 1] = plane[1, 0] = stress[p, k, 2] * DV[p, k]
             _rotate(Q[p, k].T, plane, glob)
-            for i in range(3):
-                for j in range(3):
-                    B[p, i, j] += glob[i, j]
+            _contract_contravariant(glob, jinv_all[p, k], cov)
+            for c in range(3):
+                Bab[p, c] += cov[c]
+    T[:] = 0.0
+    for p in range(nq):
+        for c in range(3):
+            T[p, c] -= Bab[p, c]
+            for m in range(tie.shape[2]):
+                if tie[c, p, m] != 0.0:
+                    T[tie_points[c, m], c] += tie[c, p, m] * Bab[p, c]
     fe[:] = 0.0
     ge[:] = 0.0
     for x in range(npts):
-        if x < nq:
-            for i in range(3):
-                for j in range(3):
-                    target[i, j] = -B[x, i, j]
-        else:
-            for i in range(3):
-                for j in range(3):
-                    acc = 0.0
-                    for p in range(nq):
-                        acc += L[p, x - nq] * B[p, i, j]
-                    target[i, j] = acc
         for k in range(nt):
-            _rotate(Q[x, k], target, local)
-            share = wt[k] / wsum
             if x < nq:
                 for i in range(5):
                     s5[i] = stress[x, k, i] * DV[x, k]
+                _lamina_to_global(s5, Q[x, k], sg)
             else:
-                s5[:] = 0.0
-            s5[0] += share * local[0, 0]
-            s5[1] += share * local[1, 1]
-            s5[2] += share * local[0, 1]
-            _lamina_to_global(s5, Q[x, k], sg)
+                sg[:] = 0.0
+            share = wt[k] / wsum
+            for i in range(3):
+                for j in range(3):
+                    sg[i, j] += share * (T[x, 0] * G[x, k, 0, i] * G[x, k, 0, j]
+                                         + T[x, 1] * G[x, k, 1, i] * G[x, k, 1, j]
+                                         + 0.5 * T[x, 2] * (G[x, k, 0, i] * G[x, k, 1, j]
+                                                            + G[x, k, 1, i] * G[x, k, 0, j]))
             _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+
+
+@njit(cache=True)
+def _lamina_strain_tensor(e5, q, plane, out):
+    """The in-plane part (11, 22, 12) of lamina strains e5 as a global tensor out (3, 3)."""
+    plane[:] = 0.0
+    plane[0, 0] = e5[0]
+    plane[1, 1] = e5[1]
+    plane[0, 1] = plane[1, 0] = 0.5 * e5[2]
+    _rotate(q.T, plane, out)
+
+
+@njit(cache=True)
+def _covariant(e, g, cov):
+    """Covariant components (rr, ss, rs) of a global tensor e with tangents g (2, 3)."""
+    for c, (a, b) in enumerate(((0, 0), (1, 1), (0, 1))):
+        acc = 0.0
+        for i in range(3):
+            for j in range(3):
+                acc += g[a, i] * e[i, j] * g[b, j]
+        cov[c] = acc
+
+
+@njit(cache=True)
+def _contravariant_tensor(c, jinv, out):
+    """Global tensor sum_ab g^a (x) g^b c_ab (ordered pairs, c_rs counted twice), with the
+    contravariant vectors g^a = jinv[a] (rows of the inverse Jacobian)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = (c[0] * jinv[0, i] * jinv[0, j] + c[1] * jinv[1, i] * jinv[1, j]
+                         + c[2] * (jinv[0, i] * jinv[1, j] + jinv[1, i] * jinv[0, j]))
+
+
+@njit(cache=True)
+def _contract_contravariant(s, jinv, out):
+    """(g^r.s.g^r, g^s.s.g^s, 2 g^r.s.g^s) of a global tensor s (3, 3): the adjoint of
+    :func:`_contravariant_tensor`."""
+    for c, (a, b, factor) in enumerate(((0, 0, 1.0), (1, 1, 1.0), (0, 1, 2.0))):
+        acc = 0.0
+        for i in range(3):
+            for j in range(3):
+                acc += jinv[a, i] * s[i, j] * jinv[b, j]
+        out[c] = factor * acc
 
 
 @njit(cache=True)
@@ -311,12 +361,13 @@ def _scratch(npts, nt):
     return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
             np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
             np.empty((npts, nt)), np.empty((npts, nt, 5)), np.empty((3, 3)), np.empty((3, 3)),
-            np.empty((3, 3)), np.empty((npts, 3, 3)), np.empty((npts - 4, 3, 3)), np.empty((3, 3)),
-            np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty(5), np.empty((3, 3)))
+            np.empty((3, 3)), np.empty((npts, nt, 2, 3)), np.empty((npts, nt, 3, 3)), np.empty((npts, 3)),
+            np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
+            np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3))
 
 
 @njit(cache=True)
-def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, stress, f, fr):
+def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2)."""
     nn = x.shape[0]
     f[:] = 0.0
@@ -338,7 +389,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, L, wq, tz, wt, j
                 de[a, i] = d[node, i]
                 ue[a, i] = ux[node, i]
                 ve[a, i] = ud[node, i]
-        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, L, wq, tz, wt, C,
+        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C,
                           stress[e], fe, ge, work)
         for a in range(9):
             node = conn[e, a]
@@ -349,7 +400,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, L, wq, tz, wt, j
 
 
 @njit(cache=True)
-def internal_forces(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C,
+def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C,
                     incremental, dx, dd, stress, f, fr):
     """Internal forces of all elements at the current configuration.
 
@@ -357,10 +408,11 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C,
     ----------
     x, d : (n, 3) current mid-surface positions and unit directors.
     h : (n,) fibre lengths. e1 : (n, 3) fibre-frame first axes.
-    conn : (ne, 9). N, dNr, dNs : (nq + 4, 9) shape functions and derivatives at the 3 x 3
-        integration points and the 2 x 2 sampling points; L (nq, 4) bilinear interpolation
-        from the sampling points; wq (nq,). tz, wt : (nt,) thickness points and weights.
-    jac0_inv : (ne, nq + 4, nt, 3, 3) inverse reference Jacobians (total formulation).
+    conn : (ne, 9). N, dNr, dNs : (npts, 9) shape functions and derivatives at the 3 x 3
+        integration points and the membrane tying points; tie, tie_points: the tying
+        interpolation (:func:`shellsim.model.integration_rule`); wq (nq,).
+        tz, wt : (nt,) thickness points and weights.
+    jac0_inv : (ne, npts, nt, 3, 3) inverse reference Jacobians (total formulation).
     C : (5, 5) reduced lamina constitutive matrix.
     incremental : False for the total formulation (stress from the total deformation,
         Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
@@ -369,12 +421,12 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C,
     stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     """
-    _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, L,
-                  wq, tz, wt, jac0_inv, C, stress, f, fr)
+    _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie,
+                  tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr)
 
 
 @njit(cache=True)
-def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, vu, vr, f, fr):
+def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vu, vr, f, fr):
     """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
 
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
@@ -383,7 +435,7 @@ def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C
     vd = np.empty((x.shape[0], 3))
     director_increments(vr, d, e1, vd)
     stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
-    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, L, wq, tz, wt, jac0_inv, C, stress, f, fr)
+    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr)
 
 
 @njit(cache=True)

@@ -157,13 +157,18 @@ def _check_stability(run: Run) -> None:
     if not broken and scale > ENERGY_FLOOR * max(abs(e[EXTERNAL]), 1e-300):
         broken = abs(run.balance_error) > UNSTABLE_BALANCE * scale and run.balance_error > 0
     if broken:
-        factor = run.deck.solver.dt_safety_factor
-        hint = (f"; solver.dt_safety_factor = {factor} < 1 puts the step above the critical step"
-                if factor < 1 else "; a larger solver.dt_safety_factor or dt_update_every smaller may help")
         raise NumericalError(
             f"the run became unstable at t = {s.t:.6g} after {s.steps} steps: energy is being "
-            f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()}); "
-            f"time step {run.dt:.4g}, critical step {run.dt_critical:.4g}{hint}")
+            f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()})"
+            f"{_time_step_hint(run)}")
+
+
+def _time_step_hint(run: Run) -> str:
+    """What the time step was, and what to change."""
+    factor = run.deck.solver.dt_safety_factor
+    advice = (f"solver.dt_safety_factor = {factor} < 1 puts the step above the critical step"
+              if factor < 1 else "a larger solver.dt_safety_factor or a smaller dt_update_every may help")
+    return f"; time step {run.dt:.4g}, critical step {run.dt_critical:.4g}; {advice}"
 
 
 def integrate(run: Run, listener: Listener | None = None) -> Run:
@@ -190,7 +195,10 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 step = remaining / max(1.0, math.ceil(remaining / run.dt - 1e-9))
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
                 while sim.state.t < target:
-                    steps = sim.advance(target, step, solver.dt_update_every - since_update)
+                    try:
+                        steps = sim.advance(target, step, solver.dt_update_every - since_update)
+                    except NumericalError as error:
+                        raise NumericalError(f"{error}{_time_step_hint(run)}") from None
                     since_update += steps
                     if since_update >= solver.dt_update_every:
                         _update_time_step(run, listener)

@@ -23,11 +23,13 @@ def test_help_lists_every_command():
 
 @pytest.mark.parametrize("args", [["run", str(DEFAULT_DECK)], ["render", "results"],
                                   ["report", "study.toml"]])
-def test_commands_still_to_come_say_so_and_fail(args):
+def test_commands_still_to_come_say_so_and_fail(args, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # nothing may be written into the checkout
     result = runner.invoke(app, args)
     assert result.exit_code == 2
     assert "not available yet" in result.output
     assert "Traceback" not in result.output
+    assert not (tmp_path / "results").exists()
 
 
 def test_check_summarises_a_valid_deck():

@@ -142,9 +142,9 @@ def run(
     from .solver.run import Listeners, integrate, prepare
 
     scene = load_deck(deck)
-    folder = _output_folder(out_dir or Path("results") / deck.stem)
     mesh_ = build_mesh(scene, deck.parent)
     current = prepare(scene, mesh_, build_model(scene, mesh_))
+    folder = _output_folder(out_dir or Path("results") / deck.stem)  # before any step is taken
     history = HistoryWriter(folder / "history.csv")
     progress = ProgressDisplay(out, scene.solver.end_time, quiet)
     message = None

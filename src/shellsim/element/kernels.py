@@ -367,6 +367,18 @@ def _scratch(npts, nt):
 
 
 @njit(cache=True)
+def _gather(nodes, x, d, h, xe, de, he):
+    """Copy one element's positions, directors (9, 3) and fibre lengths (9,) from the
+    nodal arrays."""
+    for a in range(9):
+        node = nodes[a]
+        he[a] = h[node]
+        for i in range(3):
+            xe[a, i] = x[node, i]
+            de[a, i] = d[node, i]
+
+
+@njit(cache=True)
 def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2)."""
     nn = x.shape[0]
@@ -381,14 +393,11 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     fe = np.empty((9, 3))
     ge = np.empty((9, 3))
     for e in range(conn.shape[0]):
+        _gather(conn[e], x, d, h, xe, de, he)
         for a in range(9):
-            node = conn[e, a]
-            he[a] = h[node]
             for i in range(3):
-                xe[a, i] = x[node, i]
-                de[a, i] = d[node, i]
-                ue[a, i] = ux[node, i]
-                ve[a, i] = ud[node, i]
+                ue[a, i] = ux[conn[e, a], i]
+                ve[a, i] = ud[conn[e, a], i]
         _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C,
                           stress[e], fe, ge, work)
         for a in range(9):
@@ -461,12 +470,7 @@ def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, m
     raw = np.empty(9)
     rot = np.empty(9)
     for e in range(conn.shape[0]):
-        for a in range(9):
-            node = conn[e, a]
-            he[a] = h[node]
-            for i in range(3):
-                xe[a, i] = x[node, i]
-                de[a, i] = d[node, i]
+        _gather(conn[e], x, d, h, xe, de, he)
         raw[:] = 0.0
         rot[:] = 0.0
         volume = 0.0

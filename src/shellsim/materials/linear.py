@@ -43,7 +43,3 @@ def reduced_lamina_matrix(E: float, nu: float, plane_strain: bool = False,
     reduced[4, 4] *= shear_factor
     return reduced
 
-
-def normal_stress_plane_strain(E: float, nu: float, s11: np.ndarray, s22: np.ndarray) -> np.ndarray:
-    """sigma_33 = nu (sigma_11 + sigma_22) of plane strain through the thickness."""
-    return nu * (s11 + s22)

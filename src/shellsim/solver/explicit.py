@@ -98,6 +98,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
     dx = np.zeros((n, 3))
     dd = np.zeros((n, 3))
     d_old = np.empty(3)
+    a = np.empty(3)
     steps = 0
     while steps < max_steps and t < t_stop:
         # Equal steps no longer than dt up to t_stop: a single shortened last step would
@@ -112,7 +113,6 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
         kinetic = 0.0
         for node in range(n):
             # translations: velocity update, constraint projection
-            a = np.empty(3)
             for i in range(3):
                 a[i] = ((1.0 - 0.5 * c) * v[node, i] + dt_avg * (f_ext[node, i] - f_int[node, i]) / mt[node]) / (1.0 + 0.5 * c)
             for i in range(3):

@@ -39,7 +39,8 @@ class Model:
     C [5, 5]: reduced lamina matrix; density; mass 'M1'/'M2'; damping [1/s].
     projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
     prescribed_*: nodes, axes, values, curves of prescribed translations.
-    dead_force, dead_moment [L, n, 3] with dead_curve [L].
+    dead_force [F, n, 3] with dead_force_curve [F]; dead_moment [M, n, 3] with
+    dead_moment_curve [M] (moment loads only, so a scene without them does no moment work).
     pressure_elements, pressure_face, pressure_value, pressure_curve [P].
     edge_pressure_edges [E, 3], edge_pressure_outward, edge_pressure_value, edge_pressure_curve [E].
     curve_t, curve_v [C, K] padded tables; curve_len, curve_interp, curve_extrap [C].
@@ -71,8 +72,9 @@ class Model:
     prescribed_values: np.ndarray
     prescribed_curves: np.ndarray
     dead_force: np.ndarray
+    dead_force_curve: np.ndarray
     dead_moment: np.ndarray
-    dead_curve: np.ndarray
+    dead_moment_curve: np.ndarray
     pressure_elements: np.ndarray
     pressure_face: np.ndarray
     pressure_value: np.ndarray
@@ -268,7 +270,7 @@ def _edge_integral(x0: np.ndarray, edges: np.ndarray) -> np.ndarray:
 
 def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict[str, np.ndarray]:
     n = mesh.n_nodes
-    dead_force, dead_moment, dead_curve = [], [], []
+    dead_force, dead_force_curve, dead_moment, dead_moment_curve = [], [], [], []
     pressure = {"elements": [], "face": [], "value": [], "curve": []}
     edge_pressure = {"edges": [], "outward": [], "value": [], "curve": []}
     for load in deck.load:
@@ -300,17 +302,21 @@ def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict
         else:  # body force per unit initial volume
             volume_weights = _nodal_volumes(mesh, named.elements, N, dNr, dNs, wq, tz, wt)
             force += volume_weights[:, None] * np.asarray(load.value)
-        dead_force.append(force)
-        dead_moment.append(moment)
-        dead_curve.append(curve)
+        if load.type in ("edge_moment", "point_moment"):
+            dead_moment.append(moment)
+            dead_moment_curve.append(curve)
+        else:
+            dead_force.append(force)
+            dead_force_curve.append(curve)
 
     def cat(parts, dtype, shape=(0,)):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype=dtype)
 
     return {
         "dead_force": np.asarray(dead_force).reshape(-1, n, 3),
+        "dead_force_curve": np.asarray(dead_force_curve, dtype=np.int64),
         "dead_moment": np.asarray(dead_moment).reshape(-1, n, 3),
-        "dead_curve": np.asarray(dead_curve, dtype=np.int64),
+        "dead_moment_curve": np.asarray(dead_moment_curve, dtype=np.int64),
         "pressure_elements": cat(pressure["elements"], np.int64),
         "pressure_face": cat(pressure["face"], np.int64),
         "pressure_value": cat(pressure["value"], float),

@@ -37,7 +37,7 @@ def _factor(index, time, curve_t, curve_v, curve_len, curve_interp, curve_extrap
 
 @njit(cache=True)
 def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, incremental, stress,
-           dead_force, dead_moment, dead_curve, pressure_elements, pressure_face, pressure_value,
+           dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
            pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
            curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext):
     """Internal and external forces at time t: f_* (n, 3) translational, fr_* (n, 2)
@@ -46,12 +46,20 @@ def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
                             dx, dd, stress, f_int, fr_int)
     n = x.shape[0]
     f_ext[:] = 0.0
-    moment = np.zeros((n, 3))
     g = np.zeros((n, 3))
-    for k in range(dead_curve.shape[0]):
-        c = _factor(dead_curve[k], t, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
-        f_ext += c * dead_force[k]
-        moment += c * dead_moment[k]
+    for k in range(dead_force_curve.shape[0]):
+        c = _factor(dead_force_curve[k], t, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
+        for node in range(n):
+            for i in range(3):
+                f_ext[node, i] += c * dead_force[k, node, i]
+    # A moment M turns the director by M x d: its director-conjugate force is M x d.
+    for k in range(dead_moment_curve.shape[0]):
+        c = _factor(dead_moment_curve[k], t, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
+        for node in range(n):
+            mx, my, mz = c * dead_moment[k, node, 0], c * dead_moment[k, node, 1], c * dead_moment[k, node, 2]
+            g[node, 0] += my * d[node, 2] - mz * d[node, 1]
+            g[node, 1] += mz * d[node, 0] - mx * d[node, 2]
+            g[node, 2] += mx * d[node, 1] - my * d[node, 0]
     if pressure_elements.shape[0]:
         scale = np.empty(pressure_elements.shape[0])
         for m in range(scale.shape[0]):
@@ -64,13 +72,8 @@ def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
             scale[m] = edge_value[m] * _factor(edge_curve[m], t, curve_t, curve_v, curve_len,
                                                curve_interp, curve_extrap)
         kernels.edge_pressure_forces(x, d, h, edge_edges, edge_outward, scale, f_ext)
-    # Director-conjugate forces g and moments M act on the rotational DOFs through the
-    # current fibre frame: -e1f.g, -e2f.g and -M.e2f, M.e1f (a moment M turns d by M x d).
-    for node in range(n):
-        mx, my, mz = moment[node, 0], moment[node, 1], moment[node, 2]
-        g[node, 0] += my * d[node, 2] - mz * d[node, 1]
-        g[node, 1] += mz * d[node, 0] - mx * d[node, 2]
-        g[node, 2] += mx * d[node, 1] - my * d[node, 0]
+    # Director-conjugate forces act on the rotational DOFs through the current fibre
+    # frame: -e1f.g, -e2f.g.
     kernels._to_rotational(g, d, e1, fr_ext)
 
 
@@ -79,7 +82,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
             rot_free, prescribed_nodes, prescribed_axes, prescribed_values, prescribed_curves,
             prescribed_velocity, damping,
             conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, incremental, stress,
-            dead_force, dead_moment, dead_curve, pressure_elements, pressure_face, pressure_value,
+            dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
             pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
             curve_t, curve_v, curve_len, curve_interp, curve_extrap,
             f_int, fr_int, f_ext, fr_ext, work, energy):
@@ -160,7 +163,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
                 work_int += 0.5 * fr_int[node, j] * step * w[node, j]
         t += step
         forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, incremental, stress,
-               dead_force, dead_moment, dead_curve, pressure_elements, pressure_face, pressure_value,
+               dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
                pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
                curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext)
         damped = 0.0

@@ -296,7 +296,8 @@ class Reference(Section):
     """The value a verification deck is checked against.
 
     ``measure`` turns the probe's history into one number: its ``final`` value, ``max``,
-    ``min``, ``amplitude`` (half the first peak-to-trough excursion, benchmarks 0.2),
+    ``min``, ``max_abs`` (the largest magnitude: a bound on something that should stay
+    zero), ``amplitude`` (half the first peak-to-trough excursion, benchmarks 0.2),
     ``first_peak_time``, or the value ``at_time`` ``time``. The check passes within
     ``tolerance_percent`` of ``expected``, or within ``tolerance`` (absolute, in the
     quantity's units) where a criterion is stated that way. ``source`` cites where
@@ -304,7 +305,7 @@ class Reference(Section):
 
     quantity: Annotated[str, Field(strict=True, min_length=1)]
     probe: Name
-    measure: Literal["final", "max", "min", "amplitude", "first_peak_time", "at_time"] = "final"
+    measure: Literal["final", "max", "min", "max_abs", "amplitude", "first_peak_time", "at_time"] = "final"
     time: NonNegative | None = None
     expected: Real
     tolerance_percent: Positive | None = None

@@ -165,7 +165,7 @@ def _almansi(F, eg, B):
 
 @njit(cache=True)
 def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, stress, fe, ge, work):
-    """Stresses and nodal forces of one element, with assumed membrane strains.
+    """Stresses and nodal forces of one element, with assumed membrane and shear strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
     the strain increment of the field ue, ve) or LINEAR (strain of the field ue, ve: the
@@ -182,8 +182,9 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     shells; one shared 2 x 2 set would leave three zero-energy membrane modes):
         c*_ab(p, t) = c_ab(p, t) - cbar_ab(p) + sum_m tie_ab(p, m) cbar_ab(m),
     and the change goes back into the lamina strains through the contravariant basis. The
-    bending part (the deviation through the thickness) and the transverse shears stay
-    at the point. Constant strain on straight-edged elements and rigid motion are
+    bending part (the deviation through the thickness) stays at the point. The transverse
+    shears are tied too (against shear locking of thin, distorted elements), layer by
+    layer: gamma_r on the rr points, gamma_s on the ss points. Constant strain on straight-edged elements and rigid motion are
     reproduced exactly; the virtual work of sigma . delta eps* puts effective stresses at
     the tying points too.
 
@@ -192,7 +193,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta) = work
+     local, s5, v, cov, delta, A, cov_shear, TS) = work
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -249,6 +250,23 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
             EPS[p, k, 0] += local[0, 0]
             EPS[p, k, 1] += local[1, 1]
             EPS[p, k, 2] += 2.0 * local[0, 1]
+    # Assumed transverse shear against shear locking of thin, distorted elements: the
+    # covariant shears gamma_a = g_a . gamma (gamma = (2e13, 2e23) in the lamina plane) are
+    # tied layer by layer, gamma_r on the rr points and gamma_s on the ss points (MITC9).
+    for x in range(npts):
+        for k in range(nt):
+            _lamina_tangents(Q[x, k], G[x, k], A[x, k])
+            for c in range(2):
+                cov_shear[x, k, c] = A[x, k, c, 0] * EPS[x, k, 3] + A[x, k, c, 1] * EPS[x, k, 4]
+    for p in range(nq):
+        for k in range(nt):
+            for c in range(2):
+                acc = 0.0
+                for m in range(tie.shape[2]):
+                    if tie[c, p, m] != 0.0:
+                        acc += tie[c, p, m] * cov_shear[tie_points[c, m], k, c]
+                delta[c] = acc
+            _solve2(A[p, k], delta[0], delta[1], EPS[p, k, 3:5])
             for i in range(5):
                 acc = 0.0
                 for j in range(5):
@@ -279,16 +297,26 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
             for m in range(tie.shape[2]):
                 if tie[c, p, m] != 0.0:
                     T[tie_points[c, m], c] += tie[c, p, m] * Bab[p, c]
+    # The shear stresses work through the tied covariant shears only: tau . A_p^-1 g* at
+    # the integration points puts A_m^T (sum_p tie(p, m) A_p^-T tau_p dv_p) at each tying
+    # point m, as an effective lamina shear stress there.
+    TS[:] = 0.0
+    for p in range(nq):
+        for k in range(nt):
+            _solve2(A[p, k].T, stress[p, k, 3] * DV[p, k], stress[p, k, 4] * DV[p, k], delta)
+            for c in range(2):
+                for m in range(tie.shape[2]):
+                    if tie[c, p, m] != 0.0:
+                        TS[tie_points[c, m], k, c] += tie[c, p, m] * delta[c]
     fe[:] = 0.0
     ge[:] = 0.0
     for x in range(npts):
         for k in range(nt):
-            if x < nq:
-                for i in range(5):
-                    s5[i] = stress[x, k, i] * DV[x, k]
-                _lamina_to_global(s5, Q[x, k], sg)
-            else:
-                sg[:] = 0.0
+            for i in range(3):
+                s5[i] = stress[x, k, i] * DV[x, k] if x < nq else 0.0
+            for i in range(2):
+                s5[3 + i] = TS[x, k, 0] * A[x, k, 0, i] + TS[x, k, 1] * A[x, k, 1, i]
+            _lamina_to_global(s5, Q[x, k], sg)
             share = wt[k] / wsum
             for i in range(3):
                 for j in range(3):
@@ -297,6 +325,22 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                                          + 0.5 * T[x, 2] * (G[x, k, 0, i] * G[x, k, 1, j]
                                                             + G[x, k, 1, i] * G[x, k, 0, j]))
             _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+
+
+@njit(cache=True)
+def _lamina_tangents(q, g, out):
+    """Lamina in-plane components out (2, 2) of the tangents g (2, 3): out[a, i] = g_a . e_i."""
+    for a in range(2):
+        for i in range(2):
+            out[a, i] = q[i, 0] * g[a, 0] + q[i, 1] * g[a, 1] + q[i, 2] * g[a, 2]
+
+
+@njit(cache=True)
+def _solve2(A, b0, b1, out):
+    """out[:2] = A^-1 (b0, b1) for A (2, 2)."""
+    det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    out[0] = (A[1, 1] * b0 - A[0, 1] * b1) / det
+    out[1] = (A[0, 0] * b1 - A[1, 0] * b0) / det
 
 
 @njit(cache=True)
@@ -363,7 +407,8 @@ def _scratch(npts, nt):
             np.empty((npts, nt)), np.empty((npts, nt, 5)), np.empty((3, 3)), np.empty((3, 3)),
             np.empty((3, 3)), np.empty((npts, nt, 2, 3)), np.empty((npts, nt, 3, 3)), np.empty((npts, 3)),
             np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
-            np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3))
+            np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
+            np.empty((npts, nt, 2)), np.empty((npts, nt, 2)))
 
 
 @njit(cache=True)

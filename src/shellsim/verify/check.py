@@ -50,6 +50,8 @@ def measure(reference: Reference, times: np.ndarray, values: np.ndarray) -> floa
         return float(values.max())
     if kind == "min":
         return float(values.min())
+    if kind == "max_abs":
+        return float(np.abs(values).max())
     if kind == "at_time":
         return float(np.interp(reference.time, times, values))
     peak_time, peak_value = first_peak(times, values)

@@ -60,7 +60,7 @@ def internal(model, x, d, e1):
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
     kernels.internal_forces(x, d, model.h0, e1, model.conn, model.N, model.dNr, model.dNs, model.tie, model.tie_points, model.wq,
-                            model.tz, model.wt, model.jac0_inv, model.C, False, x * 0, x * 0, stress, f, fr)
+                            model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, False, x * 0, x * 0, stress, f, fr)
     return f, fr, stress
 
 
@@ -68,7 +68,7 @@ def stiffness(model, vu, vr):
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     kernels.stiffness_product(model.x0, model.d0, model.h0, model.e1f0, model.conn, model.N, model.dNr,
-                              model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, vu, vr, f, fr)
+                              model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, vu, vr, f, fr)
     return f, fr
 
 
@@ -81,11 +81,13 @@ def moved(model, eps, vu, vr):
     return x, d, e1
 
 
-@pytest.fixture(scope="module")
-def curved():
-    """One distorted curved element: a cylindrical panel with its centre node moved."""
+@pytest.fixture(scope="module", params=[False, True], ids=["shell", "plane_strain"])
+def curved(request):
+    """One distorted curved element: a cylindrical panel with its centre node moved; as a
+    shell, and in plane strain (where the volumetric strain is projected)."""
+    section = f"thickness = {T}" + ("\nplane_strain = true" if request.param else "")
     text = deck_text('builder = "cylindrical_panel"\nradius = 2.0\nlength = 1.0\nangle_deg = 40.0',
-                     "[mesh]\ndivisions = { around = 1, along = 1 }").replace("thickness = 0.01", f"thickness = {T}")
+                     "[mesh]\ndivisions = { around = 1, along = 1 }").replace("thickness = 0.01", section)
     deck = parse_deck(text)
     mesh = build_mesh(deck)
     x = mesh.x.copy()

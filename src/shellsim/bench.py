@@ -29,15 +29,17 @@ def flops_per_element(n_thick: int = 2) -> int:
       geometry: Jacobian 252, determinant 14, inverse 36, lamina frame 60, gradient
       vectors gN, gM 198 -> 560; total Almansi strain: F 45, inverse of F F^T 80,
       rotation to the lamina 70 -> 195; covariant membrane strains: in-plane tensor 165,
-      three contractions 81, mean 6 -> 252; forces: tying terms 108, gather into the nine
-      nodes 324 -> 432.
+      three contractions 81, mean 6 -> 252; covariant transverse shears: lamina
+      tangents 20, contractions 6, their effective stress 6 -> 32; forces: tying terms
+      108, gather into the nine nodes 324 -> 432.
     Per integration point and thickness point (9 x n_thick): tensor from the covariant
       change 90, rotation 165, stress 50 -> 305; gathering the contravariant stresses 228;
-      lamina stress to global 59.
+      lamina stress to global 59; shear tying and its 2 x 2 solve 34, their adjoint 34 -> 68.
+    Plane-strain sections add the volumetric projection (not counted here).
     Per in-plane integration point: tying interpolations 36 and their adjoint 39.
     """
     points, integration = 25 * n_thick, 9 * n_thick
-    return points * (560 + 195 + 252 + 432) + integration * (305 + 228 + 59) + 9 * (36 + 39)
+    return points * (560 + 195 + 252 + 32 + 432) + integration * (305 + 228 + 59 + 68) + 9 * (36 + 39)
 
 
 def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:

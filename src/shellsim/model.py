@@ -17,7 +17,7 @@ import numpy as np
 from .deck import Deck
 from .element import kernels
 from .element.frames import initial_fibre_frame
-from .element.shape import EDGES, gauss_rule, gauss_rule_2d, shape, shape_derivatives
+from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .errors import NotYetAvailable
 from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh
@@ -36,7 +36,9 @@ class Model:
     membrane tying points; tie [3, nq, 6], tie_points [3, 6]: the tying interpolation;
     wq [nq]: in-plane weights; tz, wt [nt]: thickness rule.
     jac0_inv [ne, 25, nt, 3, 3]: inverse initial Jacobians.
-    C [5, 5]: reduced lamina matrix; density; mass 'M1'/'M2'; damping [1/s].
+    C [5, 5]: reduced lamina matrix; vol_basis [nq, nb]: fields the in-plane volumetric
+    strain is projected on (plane strain: 1, r, s; otherwise nb = 0, no projection);
+    density; mass 'M1'/'M2'; damping [1/s].
     projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
     prescribed_*: nodes, axes, values, curves of prescribed translations.
     dead_force [F, n, 3] with dead_force_curve [F]; dead_moment [M, n, 3] with
@@ -61,6 +63,7 @@ class Model:
     wt: np.ndarray
     jac0_inv: np.ndarray
     C: np.ndarray
+    vol_basis: np.ndarray
     density: float
     mass: str
     damping: float
@@ -160,10 +163,25 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     return Model(
         x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
         conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, tie=tie, tie_points=tie_points, wq=wq, tz=tz, wt=wt,
-        jac0_inv=jac0_inv, C=C, density=material.density, mass=deck.solver.mass,
+        jac0_inv=jac0_inv, C=C, vol_basis=volumetric_basis(deck.section.plane_strain, N[:len(wq)]), density=material.density, mass=deck.solver.mass,
         damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
         projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
     )
+
+
+def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
+    """(nq, nb) fields for the volumetric strain at the nq Gauss points.
+
+    In plane strain a nearly incompressible material makes the volumetric strain a
+    penalty, which the 9-node element's 9 sampling points lock under (Test 7 with
+    nu = 0.4999: -67% radial displacement); projecting it on (1, r, s) per element and
+    layer gives the stable Q9/P3 element. Plane stress (a shell) relieves the constraint
+    through the thickness strain, so no projection there (nb = 0).
+    """
+    if not plane_strain:
+        return np.zeros((len(N_gauss), 0))
+    rs = N_gauss @ NODE_RS  # the points' natural coordinates, interpolated
+    return np.column_stack([np.ones(len(rs)), rs])
 
 
 def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:

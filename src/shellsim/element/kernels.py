@@ -164,7 +164,7 @@ def _almansi(F, eg, B):
 
 
 @njit(cache=True)
-def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, stress, fe, ge, work):
+def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis, stress, fe, ge, work):
     """Stresses and nodal forces of one element, with assumed membrane and shear strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
@@ -193,7 +193,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb) = work
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -267,6 +267,11 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         acc += tie[c, p, m] * cov_shear[tie_points[c, m], k, c]
                 delta[c] = acc
             _solve2(A[p, k], delta[0], delta[1], EPS[p, k, 3:5])
+    nb = vol_basis.shape[1]
+    if nb:
+        _project_volumetric(EPS, DV, vol_basis, nq, nt, False, coef, rhs, Mb)
+    for p in range(nq):
+        for k in range(nt):
             for i in range(5):
                 acc = 0.0
                 for j in range(5):
@@ -275,6 +280,10 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                     stress[p, k, i] += acc
                 else:
                     stress[p, k, i] = acc
+            for i in range(3):
+                SW[p, k, i] = stress[p, k, i] * DV[p, k]
+    if nb:
+        _project_volumetric(SW, DV, vol_basis, nq, nt, True, coef, rhs, Mb)
     # Virtual work: the direct terms s dv at (p, k). The in-plane stresses, contracted
     # with the contravariant basis, Bab(p) = sum_k dv g^a . sigma_m . g^b (twice for rs),
     # act back through -cbar(p) at the integration points and through the tying at the
@@ -283,9 +292,9 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     for p in range(nq):
         for k in range(nt):
             plane[:] = 0.0
-            plane[0, 0] = stress[p, k, 0] * DV[p, k]
-            plane[1, 1] = stress[p, k, 1] * DV[p, k]
-            plane[0, 1] = plane[1, 0] = stress[p, k, 2] * DV[p, k]
+            plane[0, 0] = SW[p, k, 0]
+            plane[1, 1] = SW[p, k, 1]
+            plane[0, 1] = plane[1, 0] = SW[p, k, 2]
             _rotate(Q[p, k].T, plane, glob)
             _contract_contravariant(glob, jinv_all[p, k], cov)
             for c in range(3):
@@ -313,7 +322,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     for x in range(npts):
         for k in range(nt):
             for i in range(3):
-                s5[i] = stress[x, k, i] * DV[x, k] if x < nq else 0.0
+                s5[i] = SW[x, k, i] if x < nq else 0.0
             for i in range(2):
                 s5[3 + i] = TS[x, k, 0] * A[x, k, 0, i] + TS[x, k, 1] * A[x, k, 1, i]
             _lamina_to_global(s5, Q[x, k], sg)
@@ -325,6 +334,48 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                                          + 0.5 * T[x, 2] * (G[x, k, 0, i] * G[x, k, 1, j]
                                                             + G[x, k, 1, i] * G[x, k, 0, j]))
             _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+
+
+@njit(cache=True)
+def _project_volumetric(V, DV, basis, nq, nt, adjoint, coef, rhs, Mb):
+    """In-plane volumetric strain projected, layer by layer, on the fields of ``basis``
+    (nq, nb): with (1, r, s) the 9-node quadrilateral becomes Q9/P3, free of volumetric
+    locking in plane strain.
+
+    Forward (adjoint=False): V = EPS (npts, nt, 5); e_v = e11 + e22 at the integration
+    points is replaced by its L2 projection e_v* = phi^T Mb^-1 sum_p phi(p) DV(p) e_v(p),
+    the change going half into e11 and half into e22 (the deviatoric strain is untouched).
+    Adjoint (adjoint=True): V = SW (npts, nt, 3), the volume-weighted in-plane stresses;
+    with S = (SW_11 + SW_22) / 2 their virtual work through e_v* adds
+    DV(q) phi(q)^T Mb^-1 sum_p phi(p) S(p) - S(q) to both normal stresses at each point q.
+    DV (npts, nt) point volumes; coef, rhs (nb,) and Mb (nb, nb) scratch."""
+    nb = basis.shape[1]
+    for k in range(nt):
+        _projection_system(DV, basis, nq, k, Mb)
+        rhs[:] = 0.0
+        for p in range(nq):
+            weight = 0.5 if adjoint else DV[p, k]
+            for i in range(nb):
+                rhs[i] += basis[p, i] * weight * (V[p, k, 0] + V[p, k, 1])
+        coef[:] = np.linalg.solve(Mb, rhs)
+        for q in range(nq):
+            projected = 0.0
+            for i in range(nb):
+                projected += basis[q, i] * coef[i]
+            change = (DV[q, k] if adjoint else 0.5) * projected - 0.5 * (V[q, k, 0] + V[q, k, 1])
+            V[q, k, 0] += change
+            V[q, k, 1] += change
+
+
+@njit(cache=True)
+def _projection_system(DV, basis, nq, k, Mb):
+    """Mb (nb, nb) = sum_p DV(p, k) phi(p) phi(p)^T, the Gram matrix of the projection."""
+    nb = basis.shape[1]
+    Mb[:] = 0.0
+    for p in range(nq):
+        for i in range(nb):
+            for j in range(nb):
+                Mb[i, j] += DV[p, k] * basis[p, i] * basis[p, j]
 
 
 @njit(cache=True)
@@ -400,7 +451,7 @@ def _rotate(q, A, out):
 
 
 @njit(cache=True)
-def _scratch(npts, nt):
+def _scratch(npts, nt, nb):
     """Work arrays of :func:`_element_response`."""
     return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
             np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
@@ -408,7 +459,8 @@ def _scratch(npts, nt):
             np.empty((3, 3)), np.empty((npts, nt, 2, 3)), np.empty((npts, nt, 3, 3)), np.empty((npts, 3)),
             np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
-            np.empty((npts, nt, 2)), np.empty((npts, nt, 2)))
+            np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
+            np.empty(nb), np.empty((nb, nb)))
 
 
 @njit(cache=True)
@@ -424,12 +476,12 @@ def _gather(nodes, x, d, h, xe, de, he):
 
 
 @njit(cache=True)
-def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr):
+def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2)."""
     nn = x.shape[0]
     f[:] = 0.0
     g = np.zeros((nn, 3))
-    work = _scratch(N.shape[0], tz.shape[0])
+    work = _scratch(N.shape[0], tz.shape[0], vol_basis.shape[1])
     xe = np.empty((9, 3))
     de = np.empty((9, 3))
     he = np.empty(9)
@@ -443,7 +495,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
             for i in range(3):
                 ue[a, i] = ux[conn[e, a], i]
                 ve[a, i] = ud[conn[e, a], i]
-        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C,
+        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis,
                           stress[e], fe, ge, work)
         for a in range(9):
             node = conn[e, a]
@@ -454,7 +506,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
 
 
 @njit(cache=True)
-def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C,
+def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
                     incremental, dx, dd, stress, f, fr):
     """Internal forces of all elements at the current configuration.
 
@@ -476,11 +528,11 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt,
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     """
     _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie,
-                  tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr)
+                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr)
 
 
 @njit(cache=True)
-def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vu, vr, f, fr):
+def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, vu, vr, f, fr):
     """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
 
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
@@ -489,7 +541,7 @@ def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
     vd = np.empty((x.shape[0], 3))
     director_increments(vr, d, e1, vd)
     stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
-    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, stress, f, fr)
+    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr)
 
 
 @njit(cache=True)

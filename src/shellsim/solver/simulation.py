@@ -80,7 +80,7 @@ class Simulation:
 
     def _arguments(self) -> tuple:
         m, s = self.model, self.state
-        return (m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.incremental, s.stress,
+        return (m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.vol_basis, m.incremental, s.stress,
                 m.dead_force, m.dead_force_curve, m.dead_moment, m.dead_moment_curve, m.pressure_elements, m.pressure_face,
                 m.pressure_value, m.pressure_curve, m.edge_pressure_edges, m.edge_pressure_outward,
                 m.edge_pressure_value, m.edge_pressure_curve, m.curve_t, m.curve_v, m.curve_len,

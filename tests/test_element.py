@@ -10,6 +10,7 @@ import pytest
 from shellsim.deck import parse_deck
 from shellsim.element import kernels
 from shellsim.element.frames import rotate_director
+from shellsim.element.sampling import global_stress, nearest_integration_point
 from shellsim.geometry import build_mesh
 from shellsim.mesh import Mesh, averaged_directors
 from shellsim.model import build_model
@@ -172,6 +173,23 @@ def test_membrane_patch_test_on_a_skewed_mesh():
     stress, residual = membrane_patch(model)
     uniform_plane_stress(model, stress)
     assert residual < 1e-6
+
+
+@pytest.mark.parametrize("turn", [0.0, 0.5 * np.pi, 2.0])
+def test_global_stress_at_a_point_is_the_plane_stress_law_in_global_axes(turn):
+    """The stress probe's reading (lamina stress turned by the lamina frame) on the
+    stretched skewed patch, and on the same state turned rigidly about z by ``turn``:
+    R sigma R^T with sigma the plane-stress law of STRAIN in x, y."""
+    model = square_patch(skew=0.3)
+    R = rotation(np.array([0.0, 0.0, 1.0]), turn)
+    x = (model.x0 + model.x0 @ STRAIN.T) @ R.T
+    _, _, stress = internal(model, x, model.d0 @ R.T, model.e1f0 @ R.T)
+    law = model.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
+    sigma = np.array([[law[0], law[2], 0.0], [law[2], law[1], 0.0], [0.0, 0.0, 0.0]])
+    element, point = nearest_integration_point(model.x0, model.conn, model.N[:9], np.array([0.7, 0.2, 0.0]))
+    read = global_stress(x, model.d0 @ R.T, model.h0, model.conn[element], model.N[point], model.dNr[point],
+                         model.dNs[point], model.tz, model.wt, stress[element, point])
+    np.testing.assert_allclose(read, R @ sigma @ R.T, atol=1e-6 * np.abs(law).max())
 
 
 def test_membrane_patch_test_on_general_quadrilaterals_converges():

@@ -231,7 +231,9 @@ SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
 
 class Probe(Section):
     """A history written at every output step: ``quantity`` at the node of a point set
-    (a set of several nodes gives their mean)."""
+    (a set of several nodes gives their mean). ``stress`` is read at the integration
+    point nearest to the set (mean through the thickness, Cauchy, global axes), as
+    stress benchmarks compare values at Gauss points."""
 
     name: Name
     quantity: Literal[

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..deck import Deck
+from ..element.sampling import global_stress, nearest_integration_point
 from ..errors import NotYetAvailable, NumericalError
 from ..mesh import Mesh
 from ..model import Model
@@ -29,14 +30,21 @@ ENERGY_FLOOR = 1e-12
 NODAL_QUANTITIES = ("displacement", "position", "director", "rotation", "thickness")
 
 
+#: Tensor components of a probe as (row, column) of the global tensor.
+TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+
+
 @dataclass
 class Probe:
-    """Where a deck's probe reads: its nodes, quantity and component."""
+    """Where a deck's probe reads: its nodes, quantity and component; for stress, the
+    integration point (element, in-plane point) nearest to the nodes."""
 
     name: str
     quantity: str
     component: str
     nodes: np.ndarray
+    element: int = -1
+    point: int = -1
 
 
 @dataclass
@@ -93,6 +101,10 @@ def probe_value(run: Run, probe: Probe) -> float:
     """The probe's current value (the mean over its nodes)."""
     s, m = run.sim.state, run.model
     nodes = probe.nodes
+    if probe.quantity == "stress":
+        e, p = probe.element, probe.point
+        tensor = global_stress(s.x, s.d, s.h, m.conn[e], m.N[p], m.dNr[p], m.dNs[p], m.tz, m.wt, s.stress[e, p])
+        return float(tensor[TENSOR_COMPONENTS[probe.component]])
     if probe.quantity == "thickness":
         return float(s.h[nodes].mean())
     if probe.quantity == "rotation":
@@ -107,9 +119,15 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     """A run ready to start: simulation built, probes resolved."""
     probes = []
     for p in deck.output.probe:
+        nodes = mesh.sets[p.set].nodes
+        if p.quantity == "stress":
+            element, point = nearest_integration_point(model.x0, model.conn, model.N[:len(model.wq)],
+                                                       model.x0[nodes].mean(axis=0))
+            probes.append(Probe(p.name, p.quantity, p.component, nodes, element, point))
+            continue
         if p.quantity not in NODAL_QUANTITIES:
             raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
-        probes.append(Probe(p.name, p.quantity, p.component, mesh.sets[p.set].nodes))
+        probes.append(Probe(p.name, p.quantity, p.component, nodes))
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
     return run

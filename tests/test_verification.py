@@ -22,6 +22,7 @@ DECKS = [
     "test07_thick_cylinder_2x3_nu04999.toml",
     "test05_scordelis_lo_6x6.toml",
     "test06_twisted_beam_8_inplane.toml",
+    "test06_twisted_beam_8_outofplane.toml",
 ]
 
 

@@ -30,9 +30,11 @@ def run_deck(deck):
     return integrate(prepare(deck, mesh, build_model(deck, mesh)))
 
 
-@pytest.fixture(scope="module")
-def plate_run():
-    return run_deck(load_deck(PLATE))
+@pytest.fixture(scope="module", params=["total", "incremental"])
+def plate_run(request):
+    """Test 1 in the total (Eq 3.1) and the incremental (Eq 3.2) formulation."""
+    text = PLATE.read_text().replace("[section]", f'[section]\nformulation = "{request.param}"', 1)
+    return run_deck(parse_deck(text, name=PLATE.name, base_dir=PLATE.parent))
 
 
 def test_undamped_run_conserves_energy(plate_run):

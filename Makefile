@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/shellsim mesh $(DECK) --out $(OUT)
+	$(BIN)/shellsim run $(DECK) --out $(OUT)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

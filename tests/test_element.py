@@ -61,7 +61,7 @@ def internal(model, x, d, e1):
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
     kernels.internal_forces(x, d, model.h0, e1, model.conn, model.N, model.dNr, model.dNs, model.tie, model.tie_points, model.wq,
-                            model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, False, x * 0, x * 0, stress, f, fr)
+                            model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material, False, x * 0, x * 0, stress, f, fr)
     return f, fr, stress
 
 
@@ -69,7 +69,7 @@ def stiffness(model, vu, vr):
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     kernels.stiffness_product(model.x0, model.d0, model.h0, model.e1f0, model.conn, model.N, model.dNr,
-                              model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, vu, vr, f, fr)
+                              model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material, vu, vr, f, fr)
     return f, fr
 
 

@@ -19,6 +19,7 @@ from .element import kernels
 from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .errors import NotYetAvailable
+from .materials import hyperelastic
 from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh
 
@@ -36,7 +37,9 @@ class Model:
     membrane tying points; tie [3, nq, 6], tie_points [3, 6]: the tying interpolation;
     wq [nq]: in-plane weights; tz, wt [nt]: thickness rule.
     jac0_inv [ne, 25, nt, 3, 3]: inverse initial Jacobians.
-    C [5, 5]: reduced lamina matrix; vol_basis [nq, nb]: fields the in-plane volumetric
+    C [5, 5]: reduced lamina matrix (small-strain law); material: (law, params [4],
+    axes0 [ne, nq, nt, 3, 3] or [1, ...] unused, h0 [n], thickness_update) for the kernels
+    (:func:`shellsim.element.kernels.internal_forces`); vol_basis [nq, nb]: fields the in-plane volumetric
     strain is projected on (plane strain: 1, r, s; otherwise nb = 0, no projection);
     density; mass 'M1'/'M2'; damping [1/s].
     projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
@@ -63,6 +66,7 @@ class Model:
     wt: np.ndarray
     jac0_inv: np.ndarray
     C: np.ndarray
+    material: tuple
     vol_basis: np.ndarray
     density: float
     mass: str
@@ -150,12 +154,9 @@ def _lagrange(x: np.ndarray, node: float, nodes: np.ndarray) -> np.ndarray:
 def build_model(deck: Deck, mesh: Mesh) -> Model:
     """Flatten ``deck`` and ``mesh`` into a :class:`Model`."""
     material = deck.material
-    if material.model != "linear_elastic":
-        raise NotYetAvailable(f"material.model = '{material.model}' needs the large-strain "
-                              "constitutive laws, which are not available yet")
     N, dNr, dNs, tie, tie_points, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
-    C = reduced_lamina_matrix(material.E, material.nu, deck.section.plane_strain)
     jac0_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)
+    C, law = _constitutive(deck, mesh, N[:len(wq)], dNr[:len(wq)], dNs[:len(wq)], tz)
     projector, rot_free, e1f0, prescribed = _boundary_conditions(deck, mesh)
     curve_names = list(deck.curves)
     loads = _loads(deck, mesh, curve_names, N, dNr, dNs, wq, tz, wt)
@@ -163,10 +164,69 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     return Model(
         x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
         conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, tie=tie, tie_points=tie_points, wq=wq, tz=tz, wt=wt,
-        jac0_inv=jac0_inv, C=C, vol_basis=volumetric_basis(deck.section.plane_strain, N[:len(wq)]), density=material.density, mass=deck.solver.mass,
+        jac0_inv=jac0_inv, C=C, material=law, vol_basis=volumetric_basis(deck.section.plane_strain, N[:len(wq)]), density=material.density, mass=deck.solver.mass,
         damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
         projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
     )
+
+
+def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, tuple]:
+    """The small-strain matrix C (5, 5) and the kernels' material tuple (see :class:`Model`).
+
+    A linear elastic material without a technique is the small-strain path; a hyperelastic
+    one runs Technique 1 (total formulation, zero normal stress by J = 1), with its
+    material frames at the Gauss points (N, dNr, dNs: (nq, 9)) of the initial shape.
+    """
+    material, section = deck.material, deck.section
+    h0 = mesh.thickness.copy()
+    if not material.HYPERELASTIC:
+        if section.technique is not None:
+            raise NotYetAvailable(f"section.technique = {section.technique} with a linear elastic material "
+                                  "(Techniques 2 and 3, St. Venant-Kirchhoff under Technique 1) is not available yet")
+        unused = np.zeros((1, len(N), len(tz), 3, 3))
+        return (reduced_lamina_matrix(material.E, material.nu, section.plane_strain),
+                (hyperelastic.LINEAR, np.zeros(4), unused, h0, False))
+    if section.technique not in (None, 1):
+        raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
+                              "Technique 1; Techniques 2 and 3 take a linear elastic material")
+    if section.formulation != "total" or section.plane_strain:
+        raise NotYetAvailable("a hyperelastic material runs Technique 1 in the total formulation with zero normal "
+                              "stress (section.formulation = 'total', plane_strain = false)")
+    if material.model == "guccione":
+        law, params = hyperelastic.GUCCIONE, [material.C1, material.C2, material.C3, material.C4]
+    else:
+        law, params = hyperelastic.MOONEY_RIVLIN, [material.C1, getattr(material, "C2", 0.0), 0.0, 0.0]
+    axes0 = material_frames(mesh, getattr(material, "axes", None), N, dNr, dNs, tz)
+    return np.zeros((5, 5)), (law, np.asarray(params, dtype=float), axes0, h0, deck.thickness_update)
+
+
+def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
+    """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
+    a3 the lamina normal g_r x g_s / |.|, a1 the preferred direction projected on the
+    lamina (circumferential about ``axes.axis`` for cylindrical axes, ``axes.direction``
+    for fixed ones, g_r for an isotropic law or where the preferred direction is normal
+    to the lamina, e.g. on a tube's axis), a2 = a3 x a1."""
+    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
+    out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
+    for k, t in enumerate(tz):
+        pos = xe + t * fe
+        g_r, g_s = np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos)
+        normal = np.cross(g_r, g_s)
+        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+        if axes is None:
+            preferred = g_r
+        elif axes.kind == "cylindrical":
+            point = np.einsum("qa,eai->eqi", N, pos) - np.asarray(axes.origin)
+            preferred = np.cross(np.asarray(axes.axis, dtype=float), point)
+        else:
+            preferred = np.broadcast_to(np.asarray(axes.direction, dtype=float), g_r.shape)
+        a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
+        size = np.linalg.norm(a1, axis=-1, keepdims=True)
+        fallback = g_r - np.sum(g_r * normal, axis=-1, keepdims=True) * normal
+        a1 = np.where(size > 1e-9 * np.linalg.norm(preferred, axis=-1, keepdims=True) + 1e-300, a1, fallback)
+        a1 /= np.linalg.norm(a1, axis=-1, keepdims=True)
+        out[:, :, k] = np.stack([a1, np.cross(normal, a1), normal], axis=-2)
+    return out
 
 
 def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:

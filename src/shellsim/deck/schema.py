@@ -233,7 +233,9 @@ class Probe(Section):
     """A history written at every output step: ``quantity`` at the node of a point set
     (a set of several nodes gives their mean). ``stress`` is read at the integration
     point nearest to the set (mean through the thickness, Cauchy, global axes), as
-    stress benchmarks compare values at Gauss points."""
+    stress benchmarks compare values at Gauss points. ``face`` reads a position or
+    displacement on the bottom or top face (along the director, half the current fibre
+    length from the mid-surface), e.g. the inner radius of a vessel."""
 
     name: Name
     quantity: Literal[
@@ -244,9 +246,12 @@ class Probe(Section):
     component: Literal[
         "x", "y", "z", "magnitude", "xx", "yy", "zz", "xy", "yz", "zx", "scalar"
     ] = "scalar"
+    face: Literal["bottom", "mid", "top"] = "mid"
 
     @model_validator(mode="after")
     def _component_fits(self) -> "Probe":
+        if self.face != "mid" and self.quantity not in ("position", "displacement"):
+            raise ValueError(f"face = '{self.face}' reads a position or displacement, not {self.quantity}")
         allowed = (
             ("x", "y", "z", "magnitude") if self.quantity in VECTOR_QUANTITIES
             else ("xx", "yy", "zz", "xy", "yz", "zx") if self.quantity in TENSOR_QUANTITIES

@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..materials import hyperelastic
 from .frames import lamina_frame
 
 
@@ -164,7 +165,8 @@ def _almansi(F, eg, B):
 
 
 @njit(cache=True)
-def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis, stress, fe, ge, work):
+def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis, law, params,
+                      axes0, stress, stretch, fe, ge, work):
     """Stresses and nodal forces of one element, with assumed membrane and shear strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
@@ -188,12 +190,19 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     reproduced exactly; the virtual work of sigma . delta eps* puts effective stresses at
     the tying points too.
 
-    xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3) (TOTAL only);
-    stress (nq, nt, 5) read (INCREMENTAL) and written; fe, ge (9, 3) overwritten;
-    work: scratch from :func:`_scratch`.
+    Constitutive law: ``law`` LINEAR uses the reduced matrix C (5, 5); a hyperelastic law
+    (:mod:`shellsim.materials.hyperelastic`, Technique 1, TOTAL and LINEAR modes) takes
+    its parameters ``params`` (4,) and the initial material frames ``axes0`` (nq, nt, 3, 3)
+    (see :func:`_hyperelastic_point`).
+
+    xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3);
+    stress (nq, nt, 5) read (INCREMENTAL) and written; stretch (nq,): the through-thickness
+    mean normal stretch at each point (hyperelastic TOTAL only; else left alone);
+    fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct) = work
+    hyper = law != hyperelastic.LINEAR
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -211,13 +220,16 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 G[p, k, 0, i] = jac[i, 0]
                 G[p, k, 1, i] = jac[i, 1]
             DV[p, k] = det * wq[p] * wt[k] if p < nq else 0.0
-            if mode == TOTAL:
+            if mode == TOTAL or (hyper and p < nq):
                 for i in range(3):
                     for j in range(3):
                         acc = 0.0
                         for m in range(3):
                             acc += jac[i, m] * jac0_inv[p, k, m, j]
                         F[i, j] = acc
+                        if p < nq:
+                            FP[p, k, i, j] = acc
+            if mode == TOTAL:
                 _almansi(F, eg, v)
             else:
                 _gradient_of(ue, ve, gN, gM, F)
@@ -225,6 +237,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
             _global_to_lamina_strain(eg, q, EPS[p, k], v)
+            if hyper and p < nq:
+                EPS0[p, k] = EPS[p, k]
     # Covariant membrane strains c_ab = g_a . eps . g_b (a, b in r, s), frame-free, and their
     # through-thickness means cbar (the membrane part), at every point.
     cbar[:] = 0.0
@@ -271,15 +285,28 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     if nb:
         _project_volumetric(EPS, DV, vol_basis, nq, nt, False, coef, rhs, Mb)
     for p in range(nq):
+        if hyper and mode == TOTAL:
+            stretch[p] = 0.0
         for k in range(nt):
-            for i in range(5):
-                acc = 0.0
-                for j in range(5):
-                    acc += C[i, j] * EPS[p, k, j]
-                if mode == INCREMENTAL:
-                    stress[p, k, i] += acc
-                else:
+            if hyper and mode == TOTAL:
+                stretch[p] += wt[k] / wsum * _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k],
+                                                                 EPS0[p, k], stress[p, k], Ct, False)
+            elif hyper:  # LINEAR: the tangent at the current state times the field's strain
+                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k], s5, Ct, True)
+                for i in range(5):
+                    acc = 0.0
+                    for j in range(5):
+                        acc += Ct[i, j] * EPS[p, k, j]
                     stress[p, k, i] = acc
+            else:
+                for i in range(5):
+                    acc = 0.0
+                    for j in range(5):
+                        acc += C[i, j] * EPS[p, k, j]
+                    if mode == INCREMENTAL:
+                        stress[p, k, i] += acc
+                    else:
+                        stress[p, k, i] = acc
             for i in range(3):
                 SW[p, k, i] = stress[p, k, i] * DV[p, k]
     if nb:
@@ -334,6 +361,95 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                                          + 0.5 * T[x, 2] * (G[x, k, 0, i] * G[x, k, 1, j]
                                                             + G[x, k, 1, i] * G[x, k, 0, j]))
             _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+
+
+@njit(cache=True)
+def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent):
+    """Technique 1 at one point (thesis 3.10.1): lamina Cauchy stress out5 (5,) from a
+    hyperelastic law, or (want_tangent) its tangent Ct (5, 5) in the current lamina frame.
+
+    Fl = q F R0^T maps the initial material frame R0 (rows: axes 1, 2, 3 = normal) to the
+    current lamina frame q; its Green-Lagrange strain 1/2 (Fl^T Fl - I) gets the assumed-
+    strain correction pulled back exactly, Fl^T (eps - eps0) Fl (eps: lamina strains after
+    the tying, eps0: before; (11, 22, 2x12, 2x13, 2x23)). E33 then follows from J = 1
+    (Eq 3.28), S~ from the law, and the Cauchy stress is its push-forward
+    Fl S~ Fl^T / det Fl (Eq 3.27) in lamina components; the tangent is pushed forward
+    the same way (Eq 3.26), column by column for unit lamina strains. Returns the normal
+    stretch sqrt(1 + 2 E33)."""
+    Fl = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            tmp[i, j] = q[i, 0] * F[0, j] + q[i, 1] * F[1, j] + q[i, 2] * F[2, j]
+    for i in range(3):
+        for j in range(3):
+            Fl[i, j] = tmp[i, 0] * R0[j, 0] + tmp[i, 1] * R0[j, 1] + tmp[i, 2] * R0[j, 2]
+    det = (Fl[0, 0] * (Fl[1, 1] * Fl[2, 2] - Fl[1, 2] * Fl[2, 1])
+           - Fl[0, 1] * (Fl[1, 0] * Fl[2, 2] - Fl[1, 2] * Fl[2, 0])
+           + Fl[0, 2] * (Fl[1, 0] * Fl[2, 1] - Fl[1, 1] * Fl[2, 0]))
+    D = np.zeros((3, 3))
+    _strain_tensor(eps, eps0, D)
+    E = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            acc = -0.5 if i == j else 0.0
+            for m in range(3):
+                acc += 0.5 * Fl[m, i] * Fl[m, j]
+                for n in range(3):
+                    acc += Fl[m, i] * D[m, n] * Fl[n, j]
+            E[i, j] = acc
+    S = np.empty((3, 3))
+    Cinv = np.empty((3, 3))
+    p = hyperelastic.stress(law, params, E, S, Cinv)
+    stretch = np.sqrt(1.0 + 2.0 * E[2, 2])
+    if not want_tangent:
+        _push_forward(Fl, S, det, tmp, out5)
+        return stretch
+    unit = np.zeros(5)
+    dE = np.empty((3, 3))
+    dS = np.empty((3, 3))
+    col = np.empty(5)
+    for b in range(5):
+        unit[:] = 0.0
+        unit[b] = 1.0
+        D[:] = 0.0
+        _strain_tensor(unit, np.zeros(5), D)
+        for i in range(3):
+            for j in range(3):
+                acc = 0.0
+                for m in range(3):
+                    for n in range(3):
+                        acc += Fl[m, i] * D[m, n] * Fl[n, j]
+                dE[i, j] = acc
+        hyperelastic.tangent(law, params, E, Cinv, p, dE, dS)
+        _push_forward(Fl, dS, det, tmp, col)
+        for a in range(5):
+            Ct[a, b] = col[a]
+    return stretch
+
+
+@njit(cache=True)
+def _strain_tensor(eps, eps0, D):
+    """D (3, 3) += the lamina tensor of the strain difference eps - eps0 (5,) (engineering
+    shears halved); D[2, 2] untouched."""
+    D[0, 0] += eps[0] - eps0[0]
+    D[1, 1] += eps[1] - eps0[1]
+    D[0, 1] += 0.5 * (eps[2] - eps0[2])
+    D[1, 0] += 0.5 * (eps[2] - eps0[2])
+    D[0, 2] += 0.5 * (eps[3] - eps0[3])
+    D[2, 0] += 0.5 * (eps[3] - eps0[3])
+    D[1, 2] += 0.5 * (eps[4] - eps0[4])
+    D[2, 1] += 0.5 * (eps[4] - eps0[4])
+
+
+@njit(cache=True)
+def _push_forward(Fl, S, det, tmp, out5):
+    """Lamina components (11, 22, 12, 13, 23) of Fl S Fl^T / det; tmp (3, 3) scratch."""
+    for i in range(3):
+        for j in range(3):
+            tmp[i, j] = Fl[i, 0] * S[0, j] + Fl[i, 1] * S[1, j] + Fl[i, 2] * S[2, j]
+    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
+        out5[c] = (tmp[i, 0] * Fl[j, 0] + tmp[i, 1] * Fl[j, 1] + tmp[i, 2] * Fl[j, 2]) / det
 
 
 @njit(cache=True)
@@ -451,7 +567,7 @@ def _rotate(q, A, out):
 
 
 @njit(cache=True)
-def _scratch(npts, nt, nb):
+def _scratch(npts, nt, nb, nq):
     """Work arrays of :func:`_element_response`."""
     return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
             np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
@@ -460,7 +576,7 @@ def _scratch(npts, nt, nb):
             np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
             np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
-            np.empty(nb), np.empty((nb, nb)))
+            np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)))
 
 
 @njit(cache=True)
@@ -476,12 +592,23 @@ def _gather(nodes, x, d, h, xe, de, he):
 
 
 @njit(cache=True)
-def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr):
-    """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2)."""
+def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
+                  material, stress, f, fr):
+    """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
+
+    With a hyperelastic law in TOTAL mode, also the fibre-length update (thesis 3.11):
+    the normal stretch of the integration points, averaged to the nodes with weights
+    int N_a dv, scales the initial fibre lengths, h = h0 lambda_3. The new h serves the
+    next step, one step behind the kinematics as in the thesis.
+    """
+    law, params, axes0, h0, thickness_update = material
+    hyper = law != hyperelastic.LINEAR
     nn = x.shape[0]
+    nq = wq.shape[0]
     f[:] = 0.0
     g = np.zeros((nn, 3))
-    work = _scratch(N.shape[0], tz.shape[0], vol_basis.shape[1])
+    work = _scratch(N.shape[0], tz.shape[0], vol_basis.shape[1], nq)
+    DV = work[8]
     xe = np.empty((9, 3))
     de = np.empty((9, 3))
     he = np.empty(9)
@@ -489,6 +616,10 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     ve = np.empty((9, 3))
     fe = np.empty((9, 3))
     ge = np.empty((9, 3))
+    stretch = np.ones(nq)
+    update = thickness_update and hyper and mode == TOTAL
+    weighted = np.zeros(nn if update else 0)
+    weights = np.zeros(nn if update else 0)
     for e in range(conn.shape[0]):
         _gather(conn[e], x, d, h, xe, de, he)
         for a in range(9):
@@ -496,30 +627,46 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
                 ue[a, i] = ux[conn[e, a], i]
                 ve[a, i] = ud[conn[e, a], i]
         _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis,
-                          stress[e], fe, ge, work)
+                          law, params, axes0[e if hyper else 0], stress[e], stretch, fe, ge, work)
         for a in range(9):
             node = conn[e, a]
             for i in range(3):
                 f[node, i] += fe[a, i]
                 g[node, i] += ge[a, i]
+        if update:
+            for p in range(nq):
+                dv = 0.0
+                for k in range(tz.shape[0]):
+                    dv += DV[p, k]
+                for a in range(9):
+                    weighted[conn[e, a]] += N[p, a] * dv * stretch[p]
+                    weights[conn[e, a]] += N[p, a] * dv
     _to_rotational(g, d, e1, fr)
+    if update:
+        for node in range(nn):
+            if weights[node] > 0.0:
+                h[node] = h0[node] * weighted[node] / weights[node]
 
 
 @njit(cache=True)
-def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
+def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material,
                     incremental, dx, dd, stress, f, fr):
     """Internal forces of all elements at the current configuration.
 
     Parameters
     ----------
     x, d : (n, 3) current mid-surface positions and unit directors.
-    h : (n,) fibre lengths. e1 : (n, 3) fibre-frame first axes.
+    h : (n,) fibre lengths (updated in place when the material asks for it, see below).
+    e1 : (n, 3) fibre-frame first axes.
     conn : (ne, 9). N, dNr, dNs : (npts, 9) shape functions and derivatives at the 3 x 3
         integration points and the membrane tying points; tie, tie_points: the tying
         interpolation (:func:`shellsim.model.integration_rule`); wq (nq,).
         tz, wt : (nt,) thickness points and weights.
-    jac0_inv : (ne, npts, nt, 3, 3) inverse reference Jacobians (total formulation).
-    C : (5, 5) reduced lamina constitutive matrix.
+    jac0_inv : (ne, npts, nt, 3, 3) inverse reference Jacobians.
+    C : (5, 5) reduced lamina constitutive matrix (small-strain law).
+    material : (law, params (4,), axes0 (ne, nq, nt, 3, 3), h0 (n,), thickness_update):
+        the hyperelastic law of :mod:`shellsim.materials.hyperelastic` (LINEAR: use C),
+        its initial material frames, and the fibre-length update (h = h0 lambda_3).
     incremental : False for the total formulation (stress from the total deformation,
         Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
         in the lamina frame plus C~ times the strain increment of the last step, Eq 3.2).
@@ -528,12 +675,14 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt,
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     """
     _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie,
-                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr)
+                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, stress, f, fr)
 
 
 @njit(cache=True)
-def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, vu, vr, f, fr):
-    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K.
+def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material,
+                      vu, vr, f, fr):
+    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K:
+    with a hyperelastic law, its tangent at the current state (Eq 3.26).
 
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
     fr (n, 2). Other arguments as :func:`internal_forces`.
@@ -541,7 +690,8 @@ def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
     vd = np.empty((x.shape[0], 3))
     director_increments(vr, d, e1, vd)
     stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
-    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, stress, f, fr)
+    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
+                  material, stress, f, fr)
 
 
 @njit(cache=True)

@@ -27,6 +27,9 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None) -
     e = state.energy
     steps = max(state.steps, 1)
     scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC], 1e-300)
+    large_strain = {}
+    if plan.large_strain:
+        large_strain["volume_change_percent"] = 100.0 * (run.sim.volume() / run.sim.volume(initial=True) - 1.0)
     return {
         "deck": str(deck_path),
         "title": run.deck.meta.title,
@@ -48,6 +51,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None) -
             "balance_error_percent": 100.0 * run.balance_error / scale,
         },
         "features": {"used": plan.used(), "left_out": plan.left_out()},
+        **large_strain,
         "reference": reference_results(run),
     }
 

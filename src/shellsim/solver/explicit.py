@@ -36,13 +36,13 @@ def _factor(index, time, curve_t, curve_v, curve_len, curve_interp, curve_extrap
 
 
 @njit(cache=True)
-def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, incremental, stress,
+def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
            dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
            pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
            curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext):
     """Internal and external forces at time t: f_* (n, 3) translational, fr_* (n, 2)
     rotational. See :func:`shellsim.element.kernels.internal_forces` for the arguments."""
-    kernels.internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, incremental,
+    kernels.internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental,
                             dx, dd, stress, f_int, fr_int)
     n = x.shape[0]
     f_ext[:] = 0.0
@@ -81,7 +81,7 @@ def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
 def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt, mr, projector,
             rot_free, prescribed_nodes, prescribed_axes, prescribed_values, prescribed_curves,
             prescribed_velocity, damping,
-            conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, incremental, stress,
+            conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
             dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
             pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
             curve_t, curve_v, curve_len, curve_interp, curve_extrap,
@@ -162,7 +162,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
                 work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
                 work_int += 0.5 * fr_int[node, j] * step * w[node, j]
         t += step
-        forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, incremental, stress,
+        forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
                dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
                pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
                curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext)

@@ -43,6 +43,7 @@ class Probe:
     quantity: str
     component: str
     nodes: np.ndarray
+    face: float = 0.0  # thickness coordinate t of a position or displacement: -1, 0, +1
     element: int = -1
     point: int = -1
 
@@ -109,7 +110,13 @@ def probe_value(run: Run, probe: Probe) -> float:
         return float(s.h[nodes].mean())
     if probe.quantity == "rotation":
         return float(np.linalg.norm(s.theta[nodes], axis=1).mean())
-    vector = {"displacement": s.x - m.x0, "position": s.x, "director": s.d}[probe.quantity][nodes].mean(axis=0)
+    if probe.quantity == "director":
+        vector = s.d[nodes].mean(axis=0)
+    else:  # a position or displacement on the probe's face
+        half = 0.5 * probe.face
+        position = s.x[nodes] + half * s.h[nodes, None] * s.d[nodes]
+        start = m.x0[nodes] + half * m.h0[nodes, None] * m.d0[nodes]
+        vector = (position if probe.quantity == "position" else position - start).mean(axis=0)
     if probe.component == "magnitude":
         return float(np.linalg.norm(vector))
     return float(vector["xyz".index(probe.component)])
@@ -127,7 +134,8 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
             continue
         if p.quantity not in NODAL_QUANTITIES:
             raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
-        probes.append(Probe(p.name, p.quantity, p.component, nodes))
+        face = {"bottom": -1.0, "mid": 0.0, "top": 1.0}[p.face]
+        probes.append(Probe(p.name, p.quantity, p.component, nodes, face))
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
     return run

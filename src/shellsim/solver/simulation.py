@@ -73,6 +73,15 @@ class Simulation:
         kernels.lumped_masses(s.x, s.d, s.h, m.conn, m.N, m.dNr, m.dNs, m.wq, m.tz, m.wt, m.density,
                               m.mass == "M1", s.mt, s.mr)
 
+    def volume(self, initial: bool = False) -> float:
+        """Volume of the shell body now (or at the start) [length^3]: int dv over every
+        element, the translational M2 masses at unit density."""
+        m, s = self.model, self.state
+        x, d, h = (m.x0, m.d0, m.h0) if initial else (s.x, s.d, s.h)
+        mt, mr = np.empty(m.n_nodes), np.empty(m.n_nodes)
+        kernels.lumped_masses(x, d, h, m.conn, m.N, m.dNr, m.dNs, m.wq, m.tz, m.wt, 1.0, False, mt, mr)
+        return float(mt.sum())
+
     def critical_time_step(self) -> float:
         """dt_critical = 2 / omega_max at the current state (warm-started Lanczos)."""
         dt, self._eigenvector = critical_time_step(self, self._eigenvector)
@@ -80,7 +89,7 @@ class Simulation:
 
     def _arguments(self) -> tuple:
         m, s = self.model, self.state
-        return (m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.vol_basis, m.incremental, s.stress,
+        return (m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt, m.jac0_inv, m.C, m.vol_basis, m.material, m.incremental, s.stress,
                 m.dead_force, m.dead_force_curve, m.dead_moment, m.dead_moment_curve, m.pressure_elements, m.pressure_face,
                 m.pressure_value, m.pressure_curve, m.edge_pressure_edges, m.edge_pressure_outward,
                 m.edge_pressure_value, m.edge_pressure_curve, m.curve_t, m.curve_v, m.curve_len,

@@ -1,0 +1,97 @@
+"""Semi-analytic references: closed-end inflation of an incompressible anisotropic tube.
+
+Exact 3D solution (benchmarks.md, Tests 9 and 10) for the Guccione law of thesis Eq 4.2
+in cylindrical axes (t circumferential, z axial, r radial):
+
+    W = C1/2 (exp Q - 1),  Q = C2 E_tt^2 + C3 (E_zz^2 + E_rr^2)   (no shear strains here).
+
+Deformation r(R) with r^2 = r_i^2 + (R^2 - R_i^2) / lambda_z, theta = Theta,
+z = lambda_z Z; stretches lambda_t = r / R, lambda_z, lambda_r = 1 / (lambda_t lambda_z).
+Cauchy stress differences D_t = s_tt - s_rr = lambda_t^2 S_tt - lambda_r^2 S_rr and
+D_z = s_zz - s_rr. Radial equilibrium with s_rr(r_i) = -P, s_rr(r_o) = 0 and the closed
+end's axial balance (wall force = pi r_i^2 P) give, with r dr = R dR / lambda_z,
+
+    P = int_{R_i}^{R_o} D_t R / (lambda_z r^2) dR,
+    0 = int_{R_i}^{R_o} (2 D_z - D_t) R / lambda_z dR,
+
+solved for (r_i, lambda_z) at each pressure, continuing from (R_i, 1) at P = 0.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import quad
+from scipy.optimize import root
+
+
+def _stress_differences(R, r_i, lam_z, R_i, C):
+    """(D_t, D_z) at material radius R."""
+    C1, C2, C3, _ = C
+    r = np.sqrt(r_i**2 + (R**2 - R_i**2) / lam_z)
+    lam_t = r / R
+    lam_r = 1.0 / (lam_t * lam_z)
+    E_t, E_z, E_r = 0.5 * (lam_t**2 - 1), 0.5 * (lam_z**2 - 1), 0.5 * (lam_r**2 - 1)
+    scale = C1 * np.exp(C2 * E_t**2 + C3 * (E_z**2 + E_r**2))
+    S_t, S_z, S_r = scale * C2 * E_t, scale * C3 * E_z, scale * C3 * E_r
+    return lam_t**2 * S_t - lam_r**2 * S_r, lam_z**2 * S_z - lam_r**2 * S_r, r
+
+
+def _residuals(unknowns, pressure, R_i, R_o, C):
+    """Both balances in units of C1, for the unknowns (r_i / R_i, lambda_z)."""
+    r_i, lam_z = unknowns[0] * R_i, unknowns[1]
+
+    def hoop(R):
+        D_t, _, r = _stress_differences(R, r_i, lam_z, R_i, C)
+        return D_t * R / (lam_z * r**2)
+
+    def axial(R):
+        D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, C)
+        return (2 * D_z - D_t) * R / lam_z
+
+    return [(quad(hoop, R_i, R_o, epsrel=1e-12)[0] - pressure) / C[0],
+            quad(axial, R_i, R_o, epsrel=1e-12)[0] / (R_o**2 * C[0])]
+
+
+def tube_inflation(pressures, inner_radius: float, wall_thickness: float, C) -> tuple[np.ndarray, np.ndarray]:
+    """Inner radius r_i and axial stretch lambda_z of the closed-end tube at each pressure.
+
+    pressures (m,) [stress units], increasing from 0 or above; inner_radius R_i and
+    wall_thickness H of the unloaded tube [length]; C = (C1, C2, C3, C4) of the Guccione
+    law (C1 in stress units; C4, the shear weight, does no work here). Returns
+    (r_i (m,) [length], lambda_z (m,)). Pressures are reached by continuation in steps
+    of at most 1/50 of the largest, each solve starting from the previous solution.
+    """
+    pressures = np.asarray(pressures, dtype=float)
+    R_i, R_o = inner_radius, inner_radius + wall_thickness
+    top = max(float(pressures.max(initial=0.0)), 1e-300)
+    guess = np.array([1.0, 1.0])
+    done = 0.0
+    out_r, out_z = np.empty(len(pressures)), np.empty(len(pressures))
+    for index in np.argsort(pressures, kind="stable"):
+        target = pressures[index]
+        steps = max(1, int(np.ceil((target - done) / (top / 50))))
+        for pressure in np.linspace(done, target, steps + 1)[1:]:
+            solution = root(_residuals, guess, args=(pressure, R_i, R_o, C), method="hybr", tol=1e-13)
+            # 'no good progress' at round-off level is convergence: judge by the residual
+            if np.abs(solution.fun).max() > 1e-10:
+                raise RuntimeError(f"tube_inflation: no solution at P = {pressure:g}: {solution.message}")
+            guess = solution.x
+        done = target
+        out_r[index], out_z[index] = guess[0] * R_i, guess[1]
+    return out_r, out_z
+
+
+def through_wall_stresses(pressure: float, R, inner_radius: float, wall_thickness: float, C):
+    """Cauchy stresses (s_rr, s_tt, s_zz) (each like R) at material radii R through the
+    wall at one pressure: s_rr(R) = -int_R^{R_o} D_t R' / (lambda_z r^2) dR'."""
+    R_i, R_o = inner_radius, inner_radius + wall_thickness
+    (r_i,), (lam_z,) = tube_inflation([pressure], R_i, wall_thickness, C)
+    R = np.atleast_1d(np.asarray(R, dtype=float))
+
+    def hoop(Rp):
+        D_t, _, r = _stress_differences(Rp, r_i, lam_z, R_i, C)
+        return D_t * Rp / (lam_z * r**2)
+
+    s_rr = np.array([-quad(hoop, Ri, R_o, epsrel=1e-12)[0] for Ri in R])
+    D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, C)
+    return s_rr, s_rr + D_t, s_rr + D_z

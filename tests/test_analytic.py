@@ -1,0 +1,45 @@
+"""The semi-analytic tube-inflation reference against the tables of benchmarks.md
+(Tests 9 and 10 stand-ins) and the exact resultant checks any solution must meet."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from shellsim.verify.analytic import through_wall_stresses, tube_inflation
+
+AORTA = dict(inner_radius=10.0e-3, wall_thickness=1.5e-3, C=(25e3, 20.0, 10.0, 10.0))
+CAROTID = dict(inner_radius=1.2e-3, wall_thickness=0.5e-3, C=(20e3, 8.0, 4.0, 4.0))
+
+
+@pytest.mark.parametrize("tube, pressures, r_i, lam_z", [
+    (AORTA, [2e3, 8e3, 13.33e3, 18.66e3], [10.204888, 10.759377, 11.091432, 11.316356],
+     [1.006830, 1.035529, 1.059130, 1.077306]),
+    (CAROTID, [2e3, 13.33e3, 26.66e3], [1.238930, 1.430612, 1.531909], [1.008723, 1.095435, 1.163966]),
+])
+def test_tube_inflation_matches_the_published_tables(tube, pressures, r_i, lam_z):
+    radius, stretch = tube_inflation(np.array(pressures), **tube)
+    np.testing.assert_allclose(radius * 1e3, r_i, atol=2e-6)
+    np.testing.assert_allclose(stretch, lam_z, atol=2e-6)
+
+
+def test_through_wall_stresses_meet_the_exact_resultants():
+    """int s_tt dr = P r_i and int 2 pi r s_zz dr = pi r_i^2 P (benchmarks.md)."""
+    P, tube = 13.33e3, AORTA
+    R_i, H = tube["inner_radius"], tube["wall_thickness"]
+    (r_i,), (lam_z,) = tube_inflation([P], **tube)
+    s_rr, s_tt, s_zz = through_wall_stresses(P, [R_i, R_i + H], **tube)
+    assert s_rr[0] == pytest.approx(-P, rel=1e-9) and abs(s_rr[1]) < 1e-9 * P
+    assert s_tt[0] / 1e3 == pytest.approx(143.1916, abs=1e-3)  # benchmarks.md, R = 10.00 mm
+
+    def radius(R):
+        return np.sqrt(r_i**2 + (R**2 - R_i**2) / lam_z)
+
+    def over_r(f):  # int f dr over the wall, with dr = R dR / (lam_z r)
+        return quad(lambda R: f(R) * R / (lam_z * radius(R)), R_i, R_i + H, epsrel=1e-10)[0]
+
+    hoop = over_r(lambda R: through_wall_stresses(P, R, **tube)[1][0])
+    axial = over_r(lambda R: 2 * np.pi * radius(R) * through_wall_stresses(P, R, **tube)[2][0])
+    assert hoop == pytest.approx(P * r_i, rel=1e-7)
+    assert axial == pytest.approx(np.pi * r_i**2 * P, rel=1e-7)

@@ -18,11 +18,13 @@ from .conftest import ROOT
 DECKS = [
     "test01_nafems_21t_4x4.toml",
     "test02_cantilever_uniform_load_3.toml",
+    "test03_strip_moment_irregular3_thick.toml",
     "test07_thick_cylinder_2x3_nu049.toml",
     "test07_thick_cylinder_2x3_nu04999.toml",
     "test05_scordelis_lo_6x6.toml",
     "test06_twisted_beam_8_inplane.toml",
     "test06_twisted_beam_8_outofplane.toml",
+    "test09_aorta_slow_M2.toml",
 ]
 
 

@@ -196,12 +196,13 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     (see :func:`_hyperelastic_point`).
 
     xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3);
-    stress (nq, nt, 5) read (INCREMENTAL) and written; stretch (nq,): the through-thickness
-    mean normal stretch at each point (hyperelastic TOTAL only; else left alone);
+    stress (nq, nt, 5) read (INCREMENTAL) and written; stretch (nq,): the normal stretch
+    of the through-thickness mean strain at each point, from J = 1 (hyperelastic TOTAL
+    only; else left alone);
     fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean) = work
     hyper = law != hyperelastic.LINEAR
     nq = wq.shape[0]
     npts = N.shape[0]
@@ -285,14 +286,14 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     if nb:
         _project_volumetric(EPS, DV, vol_basis, nq, nt, False, coef, rhs, Mb)
     for p in range(nq):
-        if hyper and mode == TOTAL:
-            stretch[p] = 0.0
+        Emean[:] = 0.0
         for k in range(nt):
             if hyper and mode == TOTAL:
-                stretch[p] += wt[k] / wsum * _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k],
-                                                                 EPS0[p, k], stress[p, k], Ct, False)
+                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k], stress[p, k], Ct,
+                                    False, Emean, wt[k] / wsum)
             elif hyper:  # LINEAR: the tangent at the current state times the field's strain
-                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k], s5, Ct, True)
+                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k], s5, Ct, True,
+                                    Emean, 0.0)
                 for i in range(5):
                     acc = 0.0
                     for j in range(5):
@@ -309,6 +310,9 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         stress[p, k, i] = acc
             for i in range(3):
                 SW[p, k, i] = stress[p, k, i] * DV[p, k]
+        if hyper and mode == TOTAL:
+            # normal stretch of the fibre's mean strain: the layers' bending parts cancel
+            stretch[p] = hyperelastic.solve_normal_strain(Emean, 1.0)
     if nb:
         _project_volumetric(SW, DV, vol_basis, nq, nt, True, coef, rhs, Mb)
     # Virtual work: the direct terms s dv at (p, k). The in-plane stresses, contracted
@@ -364,7 +368,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
 
 
 @njit(cache=True)
-def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent):
+def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent, Emean, share):
     """Technique 1 at one point (thesis 3.10.1): lamina Cauchy stress out5 (5,) from a
     hyperelastic law, or (want_tangent) its tangent Ct (5, 5) in the current lamina frame.
 
@@ -374,8 +378,8 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     the tying, eps0: before; (11, 22, 2x12, 2x13, 2x23)). E33 then follows from J = 1
     (Eq 3.28), S~ from the law, and the Cauchy stress is its push-forward
     Fl S~ Fl^T / det Fl (Eq 3.27) in lamina components; the tangent is pushed forward
-    the same way (Eq 3.26), column by column for unit lamina strains. Returns the normal
-    stretch sqrt(1 + 2 E33)."""
+    the same way (Eq 3.26), column by column for unit lamina strains. Adds share x E
+    (before E33 is solved) to Emean (3, 3), for the fibre's mean strain (Eq 3.31)."""
     Fl = np.empty((3, 3))
     tmp = np.empty((3, 3))
     for i in range(3):
@@ -398,13 +402,13 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
                 for n in range(3):
                     acc += Fl[m, i] * D[m, n] * Fl[n, j]
             E[i, j] = acc
+            Emean[i, j] += share * acc
     S = np.empty((3, 3))
     Cinv = np.empty((3, 3))
     p = hyperelastic.stress(law, params, E, S, Cinv)
-    stretch = np.sqrt(1.0 + 2.0 * E[2, 2])
     if not want_tangent:
         _push_forward(Fl, S, det, tmp, out5)
-        return stretch
+        return
     unit = np.zeros(5)
     dE = np.empty((3, 3))
     dS = np.empty((3, 3))
@@ -425,7 +429,6 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         _push_forward(Fl, dS, det, tmp, col)
         for a in range(5):
             Ct[a, b] = col[a]
-    return stretch
 
 
 @njit(cache=True)
@@ -576,7 +579,8 @@ def _scratch(npts, nt, nb, nq):
             np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
             np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
-            np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)))
+            np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)),
+            np.empty((3, 3)))
 
 
 @njit(cache=True)

@@ -271,3 +271,33 @@ def test_only_rigid_motions_have_zero_energy(geometry, divisions):
         K[:, column] = np.concatenate([f.ravel(), fr.ravel()])
     eigenvalues = np.abs(np.linalg.eigvalsh(0.5 * (K + K.T)))
     assert np.sum(eigenvalues < 1e-9 * eigenvalues.max()) == 6
+
+
+def test_hyperelastic_stress_ignores_a_rigid_rotation_and_thickness_follows_the_stretch():
+    """A Mooney-Rivlin element stretched in its plane (1.3 x 0.9), then turned rigidly by
+    1 rad about a skew axis: the lamina stresses are the same (they live in the rotating
+    lamina frame, Technique 1), nonzero, and the fibre length becomes t0 lambda_3 with
+    lambda_3 = 1 / (1.3 x 0.9) (incompressible, homogeneous)."""
+    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 1, width = 1 }")
+    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3', 'model = "mooney_rivlin"\nC1 = 200.0\nC2 = 50.0')
+    deck = parse_deck(text.replace("[section]", "[section]\ntechnique = 1"))
+    model = build_model(deck, build_mesh(deck))
+    axis = np.array([1.0, 2.0, 2.0]) / 3.0
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    R = np.eye(3) + np.sin(1.0) * K + (1 - np.cos(1.0)) * K @ K
+    stretched = model.x0 * [1.3, 0.9, 1.0]
+    results = []
+    for turn in (np.eye(3), R):
+        h = model.h0.copy()
+        n = model.n_nodes
+        f, fr = np.zeros((n, 3)), np.zeros((n, 2))
+        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
+        kernels.internal_forces(stretched @ turn.T, model.d0 @ turn.T, h, model.e1f0 @ turn.T, model.conn, model.N,
+                                model.dNr, model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt,
+                                model.jac0_inv, model.C, model.vol_basis, model.material, False, f * 0, f * 0, stress, f, fr)
+        results.append((stress, h))
+    (still, h_still), (turned, h_turned) = results
+    assert np.abs(still[..., :3]).max() > 10.0
+    np.testing.assert_allclose(turned, still, atol=1e-9 * np.abs(still).max())
+    np.testing.assert_allclose(h_still, deck.section.thickness / (1.3 * 0.9), rtol=1e-12)
+    np.testing.assert_allclose(h_turned, h_still, rtol=1e-12)

@@ -43,9 +43,9 @@ class Probe:
     quantity: str
     component: str
     nodes: np.ndarray
-    face: float = 0.0  # thickness coordinate t of a position or displacement: -1, 0, +1
     element: int = -1
     point: int = -1
+    face: float = 0.0  # thickness coordinate t of a position or displacement: -1, 0, +1
 
 
 @dataclass
@@ -135,7 +135,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
         if p.quantity not in NODAL_QUANTITIES:
             raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
         face = {"bottom": -1.0, "mid": 0.0, "top": 1.0}[p.face]
-        probes.append(Probe(p.name, p.quantity, p.component, nodes, face))
+        probes.append(Probe(p.name, p.quantity, p.component, nodes, face=face))
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
     return run

@@ -25,6 +25,7 @@ DECKS = [
     "test06_twisted_beam_8_inplane.toml",
     "test06_twisted_beam_8_outofplane.toml",
     "test09_aorta_slow_M2.toml",
+    "test10_carotid_slow_M2.toml",
 ]
 
 

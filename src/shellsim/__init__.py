@@ -1,9 +1,29 @@
 """shellsim: explicit dynamics of thin and thick soft-tissue shells with the 9-node
 continuum-based shell element."""
 
+import hashlib
+import os
 from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
 
 try:
     __version__ = version("shellsim")
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0+unknown"
+
+
+def _numba_cache_dir() -> str:
+    """A compiled-code cache folder keyed by the package's source.
+
+    numba checks a cached function against its own file only, so after a change to
+    element/kernels.py the time loop in solver/explicit.py would keep running the old
+    kernels compiled into it. One folder per version of the whole source avoids that.
+    """
+    digest = hashlib.sha1()
+    for path in sorted(Path(__file__).parent.rglob("*.py")):
+        digest.update(path.read_bytes())
+    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+    return str(base / "shellsim" / "numba" / digest.hexdigest()[:16])
+
+
+os.environ.setdefault("NUMBA_CACHE_DIR", _numba_cache_dir())

@@ -602,8 +602,12 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
 
     With a hyperelastic law in TOTAL mode, also the fibre-length update (thesis 3.11):
     the normal stretch of the integration points, averaged to the nodes with weights
-    int N_a dv, scales the initial fibre lengths, h = h0 lambda_3. The new h serves the
-    next step, one step behind the kinematics as in the thesis.
+    sum_p N_a^2 dv (positive, as M1's), scales the initial fibre lengths, h = h0 lambda_3,
+    one step behind the kinematics as in the thesis. The stresses of a hyperelastic law
+    are computed on the initial fibre lengths: J = 1 fixes the thickness strain anyway,
+    and with the current ones a node-to-node difference in h tilts the layers, strains
+    them and feeds back into lambda_3 (a loop no energy stands behind, which broke Test 10
+    down). The updated h moves the faces (pressure, probes), masses and volume.
     """
     law, params, axes0, h0, thickness_update = material
     hyper = law != hyperelastic.LINEAR
@@ -625,7 +629,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     weighted = np.zeros(nn if update else 0)
     weights = np.zeros(nn if update else 0)
     for e in range(conn.shape[0]):
-        _gather(conn[e], x, d, h, xe, de, he)
+        _gather(conn[e], x, d, h0 if hyper else h, xe, de, he)
         for a in range(9):
             for i in range(3):
                 ue[a, i] = ux[conn[e, a], i]
@@ -643,8 +647,8 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
                 for k in range(tz.shape[0]):
                     dv += DV[p, k]
                 for a in range(9):
-                    weighted[conn[e, a]] += N[p, a] * dv * stretch[p]
-                    weights[conn[e, a]] += N[p, a] * dv
+                    weighted[conn[e, a]] += N[p, a] * N[p, a] * dv * stretch[p]
+                    weights[conn[e, a]] += N[p, a] * N[p, a] * dv
     _to_rotational(g, d, e1, fr)
     if update:
         for node in range(nn):

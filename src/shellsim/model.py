@@ -20,7 +20,7 @@ from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .errors import NotYetAvailable
 from .materials import hyperelastic
-from .materials.linear import reduced_lamina_matrix
+from .materials.linear import SHEAR_FACTOR, reduced_lamina_matrix
 from .mesh import Mesh
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -173,26 +173,30 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
 def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, tuple]:
     """The small-strain matrix C (5, 5) and the kernels' material tuple (see :class:`Model`).
 
-    A linear elastic material without a technique is the small-strain path; a hyperelastic
-    one runs Technique 1 (total formulation, zero normal stress by J = 1), with its
-    material frames at the Gauss points (N, dNr, dNs: (nq, 9)) of the initial shape.
+    A linear elastic material without a technique is the small-strain path, with
+    Technique 1 it is St. Venant-Kirchhoff; a hyperelastic one runs Technique 1 (total
+    formulation, zero normal stress by J = 1). Technique 1 needs the material frames at
+    the Gauss points (N, dNr, dNs: (nq, 9)) of the initial shape.
     """
     material, section = deck.material, deck.section
     h0 = mesh.thickness.copy()
-    if not material.HYPERELASTIC:
-        if section.technique is not None:
-            raise NotYetAvailable(f"section.technique = {section.technique} with a linear elastic material "
-                                  "(Techniques 2 and 3, St. Venant-Kirchhoff under Technique 1) is not available yet")
+    if not material.HYPERELASTIC and section.technique is None:
         unused = np.zeros((1, len(N), len(tz), 3, 3))
         return (reduced_lamina_matrix(material.E, material.nu, section.plane_strain),
                 (hyperelastic.LINEAR, np.zeros(4), unused, h0, False))
+    if not material.HYPERELASTIC and section.technique != 1:
+        raise NotYetAvailable(f"section.technique = {section.technique} (a constant constitutive tensor at large "
+                              "strain) is not available yet; technique = 1 gives St. Venant-Kirchhoff")
     if section.technique not in (None, 1):
         raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
                               "Technique 1; Techniques 2 and 3 take a linear elastic material")
     if section.formulation != "total" or section.plane_strain:
-        raise NotYetAvailable("a hyperelastic material runs Technique 1 in the total formulation with zero normal "
-                              "stress (section.formulation = 'total', plane_strain = false)")
-    if material.model == "guccione":
+        raise NotYetAvailable("Technique 1 runs in the total formulation with zero normal stress "
+                              "(section.formulation = 'total', plane_strain = false)")
+    if material.model == "linear_elastic":
+        lam = material.E * material.nu / ((1 + material.nu) * (1 - 2 * material.nu))
+        law, params = hyperelastic.ST_VENANT_KIRCHHOFF, [lam, material.E / (2 * (1 + material.nu)), SHEAR_FACTOR, 0.0]
+    elif material.model == "guccione":
         law, params = hyperelastic.GUCCIONE, [material.C1, material.C2, material.C3, material.C4]
     else:
         law, params = hyperelastic.MOONEY_RIVLIN, [material.C1, getattr(material, "C2", 0.0), 0.0, 0.0]

@@ -312,7 +312,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 SW[p, k, i] = stress[p, k, i] * DV[p, k]
         if hyper and mode == TOTAL:
             # normal stretch of the fibre's mean strain: the layers' bending parts cancel
-            stretch[p] = hyperelastic.solve_normal_strain(Emean, 1.0)
+            stretch[p] = hyperelastic.normal_strain(law, params, Emean)
     if nb:
         _project_volumetric(SW, DV, vol_basis, nq, nt, True, coef, rhs, Mb)
     # Virtual work: the direct terms s dv at (p, k). The in-plane stresses, contracted

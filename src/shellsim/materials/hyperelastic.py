@@ -1,4 +1,4 @@
-"""Incompressible hyperelastic laws under zero normal stress (thesis Technique 1, 3.10.1).
+"""Hyperelastic laws under zero normal stress (thesis Technique 1, 3.10.1).
 
 Everything here works in the material frame of one integration point: axis 3 is the
 lamina normal of the initial configuration, axes 1 and 2 lie in the lamina (for an
@@ -29,6 +29,10 @@ Laws (params (4,)):
   b_11 = C2, b_22 = b_33 = b_23 = C3, b_12 = b_13 = C4 (thesis Eq 4.2);
   S^w_ij = C1 e^Q b_ij E_ij;  (CC^w : dE)_ij = C1 e^Q b_ij (dE_ij + E_ij dQ),
   dQ = 2 sum_kl b_kl E_kl dE_kl.
+- ST_VENANT_KIRCHHOFF (lambda, mu, kappa, -): compressible, S = lambda tr E I + 2 mu E
+  with the transverse shears scaled by kappa (as the small-strain law); zero normal
+  stress fixes E33 = -lambda (E11 + E22) / (lambda + 2 mu) instead of J = 1, and there
+  is no pressure: S~ = S^w, dS~ = CC^w : dE with dE33 following.
 """
 
 from __future__ import annotations
@@ -37,7 +41,7 @@ import numpy as np
 from numba import njit
 
 #: Law codes of :func:`stress`; LINEAR marks the small-strain path (no law here).
-LINEAR, MOONEY_RIVLIN, GUCCIONE = -1, 0, 1
+LINEAR, MOONEY_RIVLIN, GUCCIONE, ST_VENANT_KIRCHHOFF = -1, 0, 1, 2
 
 
 @njit(cache=True)
@@ -60,6 +64,14 @@ def strain_energy(law, params, E):
             for j in range(3):
                 Q += b[i, j] * E[i, j] * E[i, j]
         return 0.5 * params[0] * (np.exp(Q) - 1.0)
+    if law == ST_VENANT_KIRCHHOFF:
+        trace = E[0, 0] + E[1, 1] + E[2, 2]
+        energy = 0.5 * params[0] * trace * trace
+        for i in range(3):
+            for j in range(3):
+                shear = params[2] if (i == 2) != (j == 2) else 1.0
+                energy += params[1] * shear * E[i, j] * E[i, j]
+        return energy
     I1 = 3.0 + 2.0 * (E[0, 0] + E[1, 1] + E[2, 2])
     trC2 = 0.0
     for i in range(3):
@@ -85,6 +97,9 @@ def _energy_stress(law, params, E, S):
             for j in range(3):
                 S[i, j] = scale * b[i, j] * E[i, j]
         return
+    if law == ST_VENANT_KIRCHHOFF:
+        _svk(params, E, S)
+        return
     I1 = 3.0 + 2.0 * (E[0, 0] + E[1, 1] + E[2, 2])
     for i in range(3):
         for j in range(3):
@@ -109,11 +124,36 @@ def _energy_tangent(law, params, E, dE, dS):
             for j in range(3):
                 dS[i, j] = scale * b[i, j] * (dE[i, j] + E[i, j] * dQ)
         return
+    if law == ST_VENANT_KIRCHHOFF:
+        _svk(params, dE, dS)
+        return
     trace = dE[0, 0] + dE[1, 1] + dE[2, 2]
     for i in range(3):
         for j in range(3):
             dS[i, j] = -4.0 * params[1] * dE[i, j]
         dS[i, i] += 4.0 * params[1] * trace
+
+
+@njit(cache=True)
+def _svk(params, E, S):
+    """S = lambda tr E I + 2 mu E, transverse shears times kappa (linear in E)."""
+    lam, mu, kappa = params[0], params[1], params[2]
+    trace = E[0, 0] + E[1, 1] + E[2, 2]
+    for i in range(3):
+        for j in range(3):
+            shear = kappa if (i == 2) != (j == 2) else 1.0
+            S[i, j] = 2.0 * mu * shear * E[i, j]
+        S[i, i] += lam * trace
+
+
+@njit(cache=True)
+def normal_strain(law, params, E):
+    """Set E[2, 2] for zero normal stress: from J = 1 for the incompressible laws, from
+    S33 = 0 for St. Venant-Kirchhoff. Returns the normal stretch sqrt(1 + 2 E33)."""
+    if law == ST_VENANT_KIRCHHOFF:
+        E[2, 2] = -params[0] * (E[0, 0] + E[1, 1]) / (params[0] + 2.0 * params[1])
+        return np.sqrt(1.0 + 2.0 * E[2, 2])
+    return solve_normal_strain(E, 1.0)
 
 
 @njit(cache=True)
@@ -150,8 +190,13 @@ def stress(law, params, E, S, Cinv):
 
     E (3, 3): strain with any E33; E33 is replaced by the incompressible solution. Writes
     S (S33 = 0) and Cinv (3, 3), (2E + I)^-1. Returns the pressure p (the constraint's
-    Lagrange multiplier)."""
-    solve_normal_strain(E, 1.0)
+    Lagrange multiplier; 0 for St. Venant-Kirchhoff, which has none)."""
+    normal_strain(law, params, E)
+    if law == ST_VENANT_KIRCHHOFF:
+        _svk(params, E, S)
+        S[2, 2] = 0.0
+        Cinv[:] = 0.0
+        return 0.0
     C = np.empty((3, 3))
     for i in range(3):
         for j in range(3):
@@ -170,6 +215,11 @@ def stress(law, params, E, S, Cinv):
 def tangent(law, params, E, Cinv, p, dE, dS):
     """dS~ (3, 3) for a strain direction dE (3, 3) at a solved state (E, Cinv, p from
     :func:`stress`). dE[2, 2] is overwritten by the constraint's value."""
+    if law == ST_VENANT_KIRCHHOFF:
+        normal_strain(law, params, dE)
+        _svk(params, dE, dS)
+        dS[2, 2] = 0.0
+        return
     acc = 0.0
     for i in range(3):
         for j in range(3):

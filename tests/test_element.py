@@ -21,18 +21,26 @@ RNG = np.random.default_rng(11)
 E, NU, T = 1000.0, 0.3, 0.05
 
 
-def make_model(geometry: str, mesh_options: str = "", extra: str = ""):
+#: A Mooney-Rivlin material under Technique 1, to replace the linear one of the base deck.
+MOONEY_RIVLIN = ('model = "mooney_rivlin"\nC1 = 200.0\nC2 = 50.0', "technique = 1")
+
+
+def make_model(geometry: str, mesh_options: str = "", extra: str = "", material: tuple[str, str] | None = None):
     text = deck_text(geometry, f"[mesh]\n{mesh_options}\n{extra}").replace("thickness = 0.01", f"thickness = {T}")
+    if material is not None:
+        law, section = material
+        text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3', law).replace("[section]", f"[section]\n{section}")
     deck = parse_deck(text)
     return deck, build_model(deck, build_mesh(deck))
 
 
-def square_patch(skew: float = 0.0, interior: tuple[float, float] = (0.5, 0.5)):
+def square_patch(skew: float = 0.0, interior: tuple[float, float] = (0.5, 0.5), material: tuple[str, str] | None = None):
     """A 2 x 2 patch of the unit square, sheared by x += skew y (elements stay
     parallelograms) and with the shared interior corner moved to ``interior`` (elements
     become general quadrilaterals); edges stay straight (mid-side nodes at mid-points,
     centres at the corner mean)."""
-    deck, model = make_model('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "divisions = { length = 2, width = 2 }")
+    deck, model = make_model('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "divisions = { length = 2, width = 2 }",
+                             material=material)
     x = model.x0.copy()
     centre = int(np.argmin(np.linalg.norm(x - [0.5, 0.5, 0.0], axis=1)))
     x[centre, :2] = interior
@@ -273,31 +281,53 @@ def test_only_rigid_motions_have_zero_energy(geometry, divisions):
     assert np.sum(eigenvalues < 1e-9 * eigenvalues.max()) == 6
 
 
-def test_hyperelastic_stress_ignores_a_rigid_rotation_and_thickness_follows_the_stretch():
+def hyperelastic_state(model, x, d, e1):
+    """(lamina stresses (ne, nq, nt, 5), updated fibre lengths (n,)) at positions x."""
+    h = model.h0.copy()
+    n = model.n_nodes
+    f, fr = np.zeros((n, 3)), np.zeros((n, 2))
+    stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
+    kernels.internal_forces(x, d, h, e1, model.conn, model.N, model.dNr, model.dNs, model.tie, model.tie_points,
+                            model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material,
+                            False, f * 0, f * 0, stress, f, fr)
+    return stress, h
+
+
+def test_hyperelastic_stress_ignores_a_rigid_rotation():
     """A Mooney-Rivlin element stretched in its plane (1.3 x 0.9), then turned rigidly by
     1 rad about a skew axis: the lamina stresses are the same (they live in the rotating
-    lamina frame, Technique 1), nonzero, and the fibre length becomes t0 lambda_3 with
-    lambda_3 = 1 / (1.3 x 0.9) (incompressible, homogeneous)."""
-    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 1, width = 1 }")
-    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3', 'model = "mooney_rivlin"\nC1 = 200.0\nC2 = 50.0')
-    deck = parse_deck(text.replace("[section]", "[section]\ntechnique = 1"))
-    model = build_model(deck, build_mesh(deck))
+    lamina frame, Technique 1), nonzero, and so is the fibre length."""
+    _, model = make_model('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "divisions = { length = 1, width = 1 }",
+                          material=MOONEY_RIVLIN)
     axis = np.array([1.0, 2.0, 2.0]) / 3.0
     K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     R = np.eye(3) + np.sin(1.0) * K + (1 - np.cos(1.0)) * K @ K
     stretched = model.x0 * [1.3, 0.9, 1.0]
-    results = []
-    for turn in (np.eye(3), R):
-        h = model.h0.copy()
-        n = model.n_nodes
-        f, fr = np.zeros((n, 3)), np.zeros((n, 2))
-        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-        kernels.internal_forces(stretched @ turn.T, model.d0 @ turn.T, h, model.e1f0 @ turn.T, model.conn, model.N,
-                                model.dNr, model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt,
-                                model.jac0_inv, model.C, model.vol_basis, model.material, False, f * 0, f * 0, stress, f, fr)
-        results.append((stress, h))
-    (still, h_still), (turned, h_turned) = results
+    still, h_still = hyperelastic_state(model, stretched, model.d0, model.e1f0)
+    turned, h_turned = hyperelastic_state(model, stretched @ R.T, model.d0 @ R.T, model.e1f0 @ R.T)
     assert np.abs(still[..., :3]).max() > 10.0
     np.testing.assert_allclose(turned, still, atol=1e-9 * np.abs(still).max())
-    np.testing.assert_allclose(h_still, deck.section.thickness / (1.3 * 0.9), rtol=1e-12)
     np.testing.assert_allclose(h_turned, h_still, rtol=1e-12)
+
+
+@pytest.mark.parametrize("interior", [(0.5, 0.5), (0.62, 0.41)])
+@pytest.mark.parametrize("stretch", [1.5, 3.26])
+def test_mooney_rivlin_patch_follows_the_exact_homogeneous_stretches(interior, stretch):
+    """Uniaxial (lambda, lambda^-1/2) and equibiaxial stretches of a 2 x 2 patch, regular
+    and distorted, up to lambda = 3.26 (Green-Lagrange 4.8, thesis Test 8): Cauchy stress
+    sigma = lambda P with P of benchmarks.md 8B at every integration point, the other
+    principal stress zero, and fibre lengths t0 lambda_3 (lambda^-1/2, lambda^-2)."""
+    C1, C2 = 200.0, 50.0
+    model = square_patch(interior=interior, material=MOONEY_RIVLIN)
+    lam = stretch
+    cases = [((lam, lam**-0.5), (lam * 2 * (lam - lam**-2) * (C1 + C2 / lam), 0.0), lam**-0.5),
+             ((lam, lam), (lam * 2 * (lam - lam**-5) * (C1 + C2 * lam**2),) * 2, lam**-2)]
+    for (sx, sy), expected, thickness_stretch in cases:
+        stress, h = hyperelastic_state(model, model.x0 * [sx, sy, 1.0], model.d0, model.e1f0)
+        s11, s22, s12 = stress[..., 0], stress[..., 1], stress[..., 2]
+        mean, radius = 0.5 * (s11 + s22), np.sqrt(0.25 * (s11 - s22) ** 2 + s12**2)
+        scale = max(expected)
+        np.testing.assert_allclose(mean + radius, max(expected), rtol=1e-9)
+        np.testing.assert_allclose(mean - radius, min(expected), atol=1e-9 * scale)
+        np.testing.assert_allclose(stress[..., 3:], 0.0, atol=1e-9 * scale)
+        np.testing.assert_allclose(h, T * thickness_stretch, rtol=1e-9)

@@ -288,9 +288,10 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     for p in range(nq):
         Emean[:] = 0.0
         for k in range(nt):
+            volume_ratio = 1.0  # true volume over the kinematic one, at which DV was taken
             if hyper and mode == TOTAL:
-                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k], stress[p, k], Ct,
-                                    False, Emean, wt[k] / wsum)
+                volume_ratio = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k],
+                                                   stress[p, k], Ct, False, Emean, wt[k] / wsum)
             elif hyper:  # LINEAR: the tangent at the current state times the field's strain
                 _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k], s5, Ct, True,
                                     Emean, 0.0)
@@ -309,7 +310,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                     else:
                         stress[p, k, i] = acc
             for i in range(3):
-                SW[p, k, i] = stress[p, k, i] * DV[p, k]
+                SW[p, k, i] = stress[p, k, i] * DV[p, k] * volume_ratio
         if hyper and mode == TOTAL:
             # normal stretch of the fibre's mean strain: the layers' bending parts cancel
             stretch[p] = hyperelastic.normal_strain(law, params, Emean)
@@ -375,11 +376,16 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     Fl = q F R0^T maps the initial material frame R0 (rows: axes 1, 2, 3 = normal) to the
     current lamina frame q; its Green-Lagrange strain 1/2 (Fl^T Fl - I) gets the assumed-
     strain correction pulled back exactly, Fl^T (eps - eps0) Fl (eps: lamina strains after
-    the tying, eps0: before; (11, 22, 2x12, 2x13, 2x23)). E33 then follows from J = 1
-    (Eq 3.28), S~ from the law, and the Cauchy stress is its push-forward
-    Fl S~ Fl^T / det Fl (Eq 3.27) in lamina components; the tangent is pushed forward
-    the same way (Eq 3.26), column by column for unit lamina strains. Adds share x E
-    (before E33 is solved) to Emean (3, 3), for the fibre's mean strain (Eq 3.31)."""
+    the tying, eps0: before; (11, 22, 2x12, 2x13, 2x23)). E33 then follows from zero
+    normal stress (Eq 3.28), S~ from the law, and the Cauchy stress is its push-forward
+    Fl S~ Fl^T / J in lamina components (Eq 3.27), J = sqrt(det(2E + I)) the true volume
+    ratio (1 when incompressible). F is taken on the initial fibre lengths, so det Fl is
+    not J: the return value J / det Fl scales the point's volume for the virtual work
+    (Fl S~ Fl^T, the Kirchhoff stress, does not depend on Fl's normal column while
+    S~_33 = 0, up to transverse shear). The tangent is pushed forward the same way
+    (Eq 3.26), column by column for unit lamina strains, per kinematic volume (det Fl).
+    Adds share x E (before E33 is solved) to Emean (3, 3), for the fibre's mean strain
+    (Eq 3.31)."""
     Fl = np.empty((3, 3))
     tmp = np.empty((3, 3))
     for i in range(3):
@@ -407,8 +413,14 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     Cinv = np.empty((3, 3))
     p = hyperelastic.stress(law, params, E, S, Cinv)
     if not want_tangent:
-        _push_forward(Fl, S, det, tmp, out5)
-        return
+        for i in range(3):
+            for j in range(3):
+                tmp[i, j] = 2.0 * E[i, j] + (1.0 if i == j else 0.0)
+        volume = np.sqrt(tmp[0, 0] * (tmp[1, 1] * tmp[2, 2] - tmp[1, 2] * tmp[2, 1])
+                         - tmp[0, 1] * (tmp[1, 0] * tmp[2, 2] - tmp[1, 2] * tmp[2, 0])
+                         + tmp[0, 2] * (tmp[1, 0] * tmp[2, 1] - tmp[1, 1] * tmp[2, 0]))
+        _push_forward(Fl, S, volume, tmp, out5)
+        return volume / det
     unit = np.zeros(5)
     dE = np.empty((3, 3))
     dS = np.empty((3, 3))
@@ -429,6 +441,7 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         _push_forward(Fl, dS, det, tmp, col)
         for a in range(5):
             Ct[a, b] = col[a]
+    return 1.0
 
 
 @njit(cache=True)

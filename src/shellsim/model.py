@@ -165,7 +165,8 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
         x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
         conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, tie=tie, tie_points=tie_points, wq=wq, tz=tz, wt=wt,
         jac0_inv=jac0_inv, C=C, material=law, vol_basis=volumetric_basis(deck.section.plane_strain, N[:len(wq)]), density=material.density, mass=deck.solver.mass,
-        damping=deck.solver.damping, incremental=deck.section.formulation == "incremental",
+        damping=deck.solver.damping,
+        incremental=deck.section.formulation == "incremental" or deck.section.technique in (2, 3),
         projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
     )
 
@@ -184,9 +185,17 @@ def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, 
         unused = np.zeros((1, len(N), len(tz), 3, 3))
         return (reduced_lamina_matrix(material.E, material.nu, section.plane_strain),
                 (hyperelastic.LINEAR, np.zeros(4), unused, h0, False))
-    if not material.HYPERELASTIC and section.technique != 1:
-        raise NotYetAvailable(f"section.technique = {section.technique} (a constant constitutive tensor at large "
-                              "strain) is not available yet; technique = 1 gives St. Venant-Kirchhoff")
+    if section.plane_strain:
+        raise NotYetAvailable("section.plane_strain with a large-strain technique is not available; "
+                              "plane strain is a small-strain section (Test 7)")
+    if not material.HYPERELASTIC and section.technique in (2, 3):
+        # constant tensor, stresses accumulated in the lamina frame from each step's
+        # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
+        unused = np.zeros((1, len(N), len(tz), 3, 3))
+        ratio = material.nu / (1.0 - material.nu)
+        return (reduced_lamina_matrix(material.E, material.nu),
+                (hyperelastic.LINEAR, np.array([float(section.technique), ratio, 0.0, 0.0]), unused, h0,
+                 deck.thickness_update))
     if section.technique not in (None, 1):
         raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
                               "Technique 1; Techniques 2 and 3 take a linear elastic material")

@@ -53,8 +53,12 @@ class MeshOptions(Section):
 class ShellSection(Section):
     """``[section]``: the shell through its thickness.
 
-    ``technique`` selects the large-strain constitutive treatment of thesis 3.10 (1, 2 or
-    3); leave it out for small strain (linear elastic only). ``plane_strain`` replaces the
+    ``technique`` selects the large-strain constitutive treatment of thesis 3.10; leave it
+    out for small strain (linear elastic only). 1: total formulation with a strain energy
+    (the hyperelastic laws; St. Venant-Kirchhoff for a linear elastic material). 2 and 3:
+    a linear elastic material at large strain, its stresses accumulated step by step from
+    the strain increments in the lamina frame (2 also pushes them forward with each
+    step's stretch, Eqs 3.29-3.30); they set the formulation themselves. ``plane_strain`` replaces the
     zero-normal-stress lamina law by plane strain through the thickness direction (an
     in-plane model of a long body, thesis Test 7). ``thickness_update`` is the fibre-length
     update of thesis 3.11 (on by default with a large-strain technique).

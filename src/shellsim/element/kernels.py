@@ -196,9 +196,14 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     (see :func:`_hyperelastic_point`).
 
     xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3);
+    Techniques 2 and 3 (law LINEAR, INCREMENTAL, params = (technique, nu / (1 - nu), -, -))
+    add C times the step's strain increment to the stresses kept in the lamina frame,
+    turn them with the material's spin relative to that frame, and (2) push them forward
+    with the step's stretch (:func:`_convect`).
     stress (nq, nt, 5) read (INCREMENTAL) and written; stretch (nq,): the normal stretch
-    of the through-thickness mean strain at each point, from J = 1 (hyperelastic TOTAL
-    only; else left alone);
+    of the through-thickness mean strain at each point, from zero normal stress
+    (hyperelastic TOTAL), or 1 + the step's mean normal strain increment (Techniques 2
+    and 3); else left alone;
     fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
@@ -237,6 +242,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 for i in range(3):
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
+                        if mode == INCREMENTAL and p < nq:
+                            FP[p, k, i, j] = F[i, j]  # the step's displacement gradient
             _global_to_lamina_strain(eg, q, EPS[p, k], v)
             if hyper and p < nq:
                 EPS0[p, k] = EPS[p, k]
@@ -287,6 +294,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
         _project_volumetric(EPS, DV, vol_basis, nq, nt, False, coef, rhs, Mb)
     for p in range(nq):
         Emean[:] = 0.0
+        if mode == INCREMENTAL and params[0] > 0.0:
+            stretch[p] = 1.0
         for k in range(nt):
             volume_ratio = 1.0  # true volume over the kinematic one, at which DV was taken
             if hyper and mode == TOTAL:
@@ -309,6 +318,12 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         stress[p, k, i] += acc
                     else:
                         stress[p, k, i] = acc
+                if mode == INCREMENTAL and params[0] > 0.0:  # Techniques 2 and 3
+                    normal = -params[1] * (EPS[p, k, 0] + EPS[p, k, 1])
+                    stretch[p] += wt[k] / wsum * normal
+                    if params[0] == 2.0:
+                        _convect(stress[p, k], EPS[p, k], normal, local, glob)
+                    _follow_material_spin(stress[p, k], FP[p, k], Q[p, k], G[p, k], local)
             for i in range(3):
                 SW[p, k, i] = stress[p, k, i] * DV[p, k] * volume_ratio
         if hyper and mode == TOTAL:
@@ -442,6 +457,69 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         for a in range(5):
             Ct[a, b] = col[a]
     return 1.0
+
+
+@njit(cache=True)
+def _follow_material_spin(s5, L, q, g, Ll):
+    """Turn accumulated lamina stresses s5 (5,) by the step's in-plane spin of the
+    material relative to the lamina frame.
+
+    The lamina frame follows the bisector of g_r and g_s (Hughes); on a distorted element
+    stretched unevenly that bisector turns against the material, and stresses kept in
+    it would turn with it (1.3% off the exact uniaxial response at lambda = 3.26 on a
+    distorted patch). The material's spin is w = (L21 - L12) / 2 in lamina components
+    (Jaumann), the frame's the mean of the turning rates of g_r and g_s,
+    (a x L a) . e3 for a unit a; the stresses turn by the difference, exactly as a
+    rotation. L (3, 3): the step's displacement gradient (global); q (3, 3): lamina
+    frame; g (2, 3): g_r, g_s; Ll (3, 3) scratch."""
+    for i in range(3):
+        for j in range(3):
+            acc = 0.0
+            for m in range(3):
+                for n in range(3):
+                    acc += q[i, m] * L[m, n] * q[j, n]
+            Ll[i, j] = acc
+    spin = 0.5 * (Ll[1, 0] - Ll[0, 1])
+    frame = 0.0
+    for a in range(2):
+        u0 = q[0, 0] * g[a, 0] + q[0, 1] * g[a, 1] + q[0, 2] * g[a, 2]
+        u1 = q[1, 0] * g[a, 0] + q[1, 1] * g[a, 1] + q[1, 2] * g[a, 2]
+        size = u0 * u0 + u1 * u1
+        frame += 0.5 * (u0 * (Ll[1, 0] * u0 + Ll[1, 1] * u1) - u1 * (Ll[0, 0] * u0 + Ll[0, 1] * u1)) / size
+    angle = spin - frame
+    c, s = np.cos(angle), np.sin(angle)
+    s11, s22, s12 = s5[0], s5[1], s5[2]
+    s5[0] = c * c * s11 - 2.0 * c * s * s12 + s * s * s22
+    s5[1] = s * s * s11 + 2.0 * c * s * s12 + c * c * s22
+    s5[2] = c * s * (s11 - s22) + (c * c - s * s) * s12
+    s13, s23 = s5[3], s5[4]
+    s5[3] = c * s13 - s * s23
+    s5[4] = s * s13 + c * s23
+
+
+@njit(cache=True)
+def _convect(s5, e5, normal, M, out):
+    """Technique 2's push-forward of the accumulated stress (thesis Eqs 3.29-3.30) over
+    one step: sigma <- M sigma M / det M, M = I + the step's lamina strain increment
+    e5 (11, 22, 2x12, 2x13, 2x23) with its normal part ``normal`` (zero normal stress).
+    Only the stretch is applied: the lamina frame already turns with the body. M, out
+    (3, 3) scratch; s5 (5,) updated."""
+    M[:] = 0.0
+    _strain_tensor(e5, np.zeros(5), M)
+    M[2, 2] = normal
+    for i in range(3):
+        M[i, i] += 1.0
+    det = (M[0, 0] * (M[1, 1] * M[2, 2] - M[1, 2] * M[2, 1]) - M[0, 1] * (M[1, 0] * M[2, 2] - M[1, 2] * M[2, 0])
+           + M[0, 2] * (M[1, 0] * M[2, 1] - M[1, 1] * M[2, 0]))
+    out[:] = 0.0
+    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
+        out[i, j] = out[j, i] = s5[c]
+    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
+        acc = 0.0
+        for m in range(3):
+            for n in range(3):
+                acc += M[i, m] * out[m, n] * M[n, j]
+        s5[c] = acc / det
 
 
 @njit(cache=True)
@@ -613,6 +691,8 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
                   material, stress, f, fr):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
+    With Techniques 2 and 3 (INCREMENTAL mode, ``params[0]`` = 2 or 3), the fibre lengths
+    are scaled each step by 1 + the step's mean normal strain increment (thesis Eq 3.33).
     With a hyperelastic law in TOTAL mode, also the fibre-length update (thesis 3.11):
     the normal stretch of the integration points, averaged to the nodes with weights
     sum_p N_a^2 dv (positive, as M1's), scales the initial fibre lengths, h = h0 lambda_3,
@@ -638,7 +718,10 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     fe = np.empty((9, 3))
     ge = np.empty((9, 3))
     stretch = np.ones(nq)
-    update = thickness_update and hyper and mode == TOTAL
+    # Technique 1 sets h = h0 lambda_3 (total), Techniques 2 and 3 scale h by each step's
+    # 1 + normal strain increment (incremental, thesis Eq 3.33)
+    incremental_update = (not hyper) and params[0] > 0.0 and mode == INCREMENTAL
+    update = thickness_update and ((hyper and mode == TOTAL) or incremental_update)
     weighted = np.zeros(nn if update else 0)
     weights = np.zeros(nn if update else 0)
     for e in range(conn.shape[0]):
@@ -666,7 +749,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     if update:
         for node in range(nn):
             if weights[node] > 0.0:
-                h[node] = h0[node] * weighted[node] / weights[node]
+                h[node] = (h[node] if incremental_update else h0[node]) * weighted[node] / weights[node]
 
 
 @njit(cache=True)

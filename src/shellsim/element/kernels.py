@@ -166,7 +166,7 @@ def _almansi(F, eg, B):
 
 @njit(cache=True)
 def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis, law, params,
-                      axes0, stress, stretch, fe, ge, work):
+                      axes0, stress, state_stress, stretch, fe, ge, work):
     """Stresses and nodal forces of one element, with assumed membrane and shear strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
@@ -204,10 +204,12 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     of the through-thickness mean strain at each point, from zero normal stress
     (hyperelastic TOTAL), or 1 + the step's mean normal strain increment (Techniques 2
     and 3); else left alone;
+    state_stress (nq, nt, 5): the current stress, whose initial-stress stiffness LINEAR adds
+    to the material one (the critical step of a stretched membrane is set by both);
     fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, VR) = work
     hyper = law != hyperelastic.LINEAR
     nq = wq.shape[0]
     npts = N.shape[0]
@@ -242,8 +244,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 for i in range(3):
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
-                        if mode == INCREMENTAL and p < nq:
-                            FP[p, k, i, j] = F[i, j]  # the step's displacement gradient
+                        if p < nq:
+                            LP[p, k, i, j] = F[i, j]  # the step's (or the field's) displacement gradient
             _global_to_lamina_strain(eg, q, EPS[p, k], v)
             if hyper and p < nq:
                 EPS0[p, k] = EPS[p, k]
@@ -298,12 +300,15 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
             stretch[p] = 1.0
         for k in range(nt):
             volume_ratio = 1.0  # true volume over the kinematic one, at which DV was taken
+            VR[p, k] = 1.0
             if hyper and mode == TOTAL:
                 volume_ratio = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k],
                                                    stress[p, k], Ct, False, Emean, wt[k] / wsum)
             elif hyper:  # LINEAR: the tangent at the current state times the field's strain
-                _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k], s5, Ct, True,
-                                    Emean, 0.0)
+                # the tangent is per kinematic volume; the initial-stress term below takes the
+                # true one, as the stress it comes from
+                VR[p, k] = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k],
+                                               s5, Ct, True, Emean, 0.0)
                 for i in range(5):
                     acc = 0.0
                     for j in range(5):
@@ -323,7 +328,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                     stretch[p] += wt[k] / wsum * normal
                     if params[0] == 2.0:
                         _convect(stress[p, k], EPS[p, k], normal, local, glob)
-                    _follow_material_spin(stress[p, k], FP[p, k], Q[p, k], G[p, k], local)
+                    _follow_material_spin(stress[p, k], LP[p, k], Q[p, k], G[p, k], local)
             for i in range(3):
                 SW[p, k, i] = stress[p, k, i] * DV[p, k] * volume_ratio
         if hyper and mode == TOTAL:
@@ -381,6 +386,19 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                                          + 0.5 * T[x, 2] * (G[x, k, 0, i] * G[x, k, 1, j]
                                                             + G[x, k, 1, i] * G[x, k, 0, j]))
             _accumulate(sg, GN[x, k], GM[x, k], 1.0, fe, ge)
+    if mode == LINEAR:
+        # initial-stress stiffness: the current stress sigma acting through the field's
+        # gradient L, f_a += L sigma gN_a dv (and gM_a for the director)
+        for p in range(nq):
+            for k in range(nt):
+                _lamina_to_global(state_stress[p, k], Q[p, k], sg)
+                for i in range(3):
+                    for j in range(3):
+                        acc = 0.0
+                        for m in range(3):
+                            acc += LP[p, k, i, m] * sg[m, j]
+                        eg[i, j] = acc
+                _accumulate(eg, GN[p, k], GM[p, k], DV[p, k] * VR[p, k], fe, ge)
 
 
 @njit(cache=True)
@@ -427,13 +445,13 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     S = np.empty((3, 3))
     Cinv = np.empty((3, 3))
     p = hyperelastic.stress(law, params, E, S, Cinv)
+    for i in range(3):
+        for j in range(3):
+            tmp[i, j] = 2.0 * E[i, j] + (1.0 if i == j else 0.0)
+    volume = np.sqrt(tmp[0, 0] * (tmp[1, 1] * tmp[2, 2] - tmp[1, 2] * tmp[2, 1])
+                     - tmp[0, 1] * (tmp[1, 0] * tmp[2, 2] - tmp[1, 2] * tmp[2, 0])
+                     + tmp[0, 2] * (tmp[1, 0] * tmp[2, 1] - tmp[1, 1] * tmp[2, 0]))
     if not want_tangent:
-        for i in range(3):
-            for j in range(3):
-                tmp[i, j] = 2.0 * E[i, j] + (1.0 if i == j else 0.0)
-        volume = np.sqrt(tmp[0, 0] * (tmp[1, 1] * tmp[2, 2] - tmp[1, 2] * tmp[2, 1])
-                         - tmp[0, 1] * (tmp[1, 0] * tmp[2, 2] - tmp[1, 2] * tmp[2, 0])
-                         + tmp[0, 2] * (tmp[1, 0] * tmp[2, 1] - tmp[1, 1] * tmp[2, 0]))
         _push_forward(Fl, S, volume, tmp, out5)
         return volume / det
     unit = np.zeros(5)
@@ -456,7 +474,7 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         _push_forward(Fl, dS, det, tmp, col)
         for a in range(5):
             Ct[a, b] = col[a]
-    return 1.0
+    return volume / det
 
 
 @njit(cache=True)
@@ -671,7 +689,7 @@ def _scratch(npts, nt, nb, nq):
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
             np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
             np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)),
-            np.empty((3, 3)))
+            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt)))
 
 
 @njit(cache=True)
@@ -688,7 +706,7 @@ def _gather(nodes, x, d, h, xe, de, he):
 
 @njit(cache=True)
 def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
-                  material, stress, f, fr):
+                  material, stress, state_stress, f, fr):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
     With Techniques 2 and 3 (INCREMENTAL mode, ``params[0]`` = 2 or 3), the fibre lengths
@@ -731,7 +749,7 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
                 ue[a, i] = ux[conn[e, a], i]
                 ve[a, i] = ud[conn[e, a], i]
         _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis,
-                          law, params, axes0[e if hyper else 0], stress[e], stretch, fe, ge, work)
+                          law, params, axes0[e if hyper else 0], stress[e], state_stress[e], stretch, fe, ge, work)
         for a in range(9):
             node = conn[e, a]
             for i in range(3):
@@ -779,23 +797,26 @@ def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt,
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     """
     _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie,
-                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, stress, f, fr)
+                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, stress, stress, f, fr)
 
 
 @njit(cache=True)
 def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material,
-                      vu, vr, f, fr):
-    """Material stiffness times a DOF vector, K_L v (thesis Eq 3.37), without forming K:
-    with a hyperelastic law, its tangent at the current state (Eq 3.26).
+                      stress, vu, vr, f, fr):
+    """Tangent stiffness times a DOF vector, K v, without forming K: the material part
+    K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
+    Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
+    thesis leaves out but a membrane stretched to large strain needs (Test 8: the step
+    from K_L alone was too long on refined meshes).
 
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
     fr (n, 2). Other arguments as :func:`internal_forces`.
     """
     vd = np.empty((x.shape[0], 3))
     director_increments(vr, d, e1, vd)
-    stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
+    field_stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
     _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
-                  material, stress, f, fr)
+                  material, field_stress, stress, f, fr)
 
 
 @njit(cache=True)

@@ -29,7 +29,7 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
         vu = np.einsum("nij,nj->ni", m.projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
         vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * m.rot_free
         kernels.stiffness_product(s.x, s.d, s.h, s.e1, m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt,
-                                  m.jac0_inv, m.C, m.vol_basis, m.material, vu, vr, fu, fr)
+                                  m.jac0_inv, m.C, m.vol_basis, m.material, s.stress, vu, vr, fu, fr)
         out_u = np.einsum("nij,nj->ni", m.projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * m.rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])

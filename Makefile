@@ -7,7 +7,7 @@ DECK   ?= decks/artery_inflation.toml
 OUT    ?= results
 STAMP  := $(VENV)/.installed
 
-.PHONY: run test bench clean
+.PHONY: run test verify bench clean
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "shellsim needs Python >= 3.11")'
@@ -21,6 +21,9 @@ run: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+verify: $(STAMP)
+	$(BIN)/python -m pytest -q -m slow
 
 bench: $(STAMP)
 	$(BIN)/shellsim bench

@@ -1,16 +1,17 @@
 """Speed, measured: the element kernel on the Scordelis-Lo 16 x 16 mesh (microseconds per
-element per step, GFLOP/s from the operation count below) and the peer-comparison plate
-(decks/bench/plate_step.toml) on a ladder of meshes (error of the first peak, wall time).
-Nothing here asserts a time; it reports."""
+element per step, GFLOP/s from the operation count below), the cost of each constitutive
+path on one scene, and the peer-comparison plate (decks/bench/plate_step.toml) on a ladder
+of meshes (error of the first peak, wall time). Nothing here asserts a time; it reports."""
 
 from __future__ import annotations
 
 import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
 
-from .deck import parse_deck
+from .deck import deck_from_data, parse_deck
 from .geometry import build_mesh
 from .model import build_model
 from .solver.run import integrate, prepare
@@ -58,6 +59,42 @@ def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:
     flops = flops_per_element(len(sim.model.tz))
     return {"elements": ne, "steps": taken, "us_per_element_step": us,
             "flops_per_element_step": flops, "gflops": flops / (us * 1e3)}
+
+
+#: Constitutive paths compared by :func:`technique_costs`: (label, material, section keys).
+LINEAR = {"model": "linear_elastic", "E": 1.0e5, "nu": 0.3, "density": 1050.0}
+MOONEY_RIVLIN = {"model": "mooney_rivlin", "C1": 20.0e3, "C2": 5.0e3, "density": 1050.0}
+PATHS = [
+    ("small strain (linear elastic)", LINEAR, {}),
+    ("Technique 1, St. Venant-Kirchhoff", LINEAR, {"technique": 1}),
+    ("Technique 1, Mooney-Rivlin", MOONEY_RIVLIN, {"technique": 1}),
+    ("Technique 1, Mooney-Rivlin, no thickness update", MOONEY_RIVLIN, {"technique": 1, "thickness_update": False}),
+    ("Technique 1, Guccione (anisotropic)", None, {"technique": 1}),
+    ("Technique 2", LINEAR, {"technique": 2}),
+    ("Technique 3", LINEAR, {"technique": 3}),
+]
+
+
+def technique_costs(steps: int = 300) -> list[dict]:
+    """Microseconds per element per step of the full time step for each constitutive path
+    of :data:`PATHS` on the Test 9 tube (decks/verification/test09_aorta_slow_M2.toml,
+    19 elements, Guccione where the material is None), from the same state and step."""
+    base = tomllib.loads((DECKS / "verification" / "test09_aorta_slow_M2.toml").read_text())
+    rows = []
+    for label, material, section in PATHS:
+        data = dict(base, reference=[])
+        data["section"] = {k: v for k, v in base["section"].items() if k != "technique"} | section
+        if material is not None:
+            data["material"] = material
+        deck = deck_from_data(data)
+        sim = Simulation(build_model(deck, build_mesh(deck)))
+        dt = sim.critical_time_step() / 2.0
+        sim.advance(10 * dt, dt, 10)  # compile and warm up
+        start = time.perf_counter()
+        taken = sim.advance(sim.state.t + steps * dt, dt, steps)
+        us = 1e6 * (time.perf_counter() - start) / (taken * sim.model.n_elements)
+        rows.append({"path": label, "us_per_element_step": us})
+    return rows
 
 
 def plate_ladder(divisions=(2, 4, 8)) -> list[dict]:

@@ -214,13 +214,22 @@ def bench(
     out_dir: Annotated[Path | None, typer.Option("--out", help="Also write bench.json here.")] = None,
 ) -> None:
     """Measure speed: microseconds per element per step and GFLOP/s of the element kernel
-    (Scordelis-Lo 16 x 16), and the bench plate's error and wall time per mesh."""
-    from .bench import kernel_speed, plate_ladder
+    (Scordelis-Lo 16 x 16), the cost of each constitutive path, and the bench plate's
+    error and wall time per mesh."""
+    from .bench import kernel_speed, plate_ladder, technique_costs
 
     kernel = kernel_speed()
     out.print(f"kernel (Scordelis-Lo, {kernel['elements']} elements, {kernel['steps']} steps): "
               f"{kernel['us_per_element_step']:.2f} us per element-step, "
               f"{kernel['flops_per_element_step']:,} flop per element-step, {kernel['gflops']:.2f} GFLOP/s")
+    costs = technique_costs()
+    small = costs[0]["us_per_element_step"]
+    paths = Table(title="constitutive paths (Test 9 tube, 19 elements)", title_justify="left")
+    for column in ("path", "us/element-step", "against small strain"):
+        paths.add_column(column)
+    for row in costs:
+        paths.add_row(row["path"], f"{row['us_per_element_step']:.2f}", f"{row['us_per_element_step'] / small:.2f} x")
+    out.print(paths)
     ladder = plate_ladder()
     table = Table(title="bench plate (decks/bench/plate_step.toml): first peak", title_justify="left")
     for column in ("mesh", "elements", "steps", "wall time [s]", "us/element-step", "peak error", "peak time error"):
@@ -233,7 +242,7 @@ def bench(
     if out_dir is not None:
         from .output.summary import write_json
 
-        write_json({"kernel": kernel, "plate": ladder}, _output_folder(out_dir) / "bench.json")
+        write_json({"kernel": kernel, "paths": costs, "plate": ladder}, _output_folder(out_dir) / "bench.json")
 
 
 def _output_folder(path: Path) -> Path:

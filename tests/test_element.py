@@ -409,3 +409,20 @@ def test_tangent_with_initial_stress_is_the_derivative_of_the_force_when_stretch
                               model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis,
                               model.material, stress, vu, vr, f, fr)
     np.testing.assert_allclose(f, derivative, atol=1e-7 * np.abs(derivative).max())
+
+
+def test_m2_rotary_inertia_does_not_depend_on_the_thickness_rule():
+    """Flat plate: M2's director masses with 1, 2 and 3 points through the thickness are
+    the same (the 1-point rule alone would give none: t = 0)."""
+    masses = []
+    for points in (1, 2, 3):
+        _, model = make_model('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', "divisions = { length = 2, width = 2 }",
+                              material=('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+                                        f"points_through_thickness = {points}"))
+        mt, mr = np.empty(model.n_nodes), np.empty(model.n_nodes)
+        kernels.lumped_masses(model.x0, model.d0, model.h0, model.conn, model.N, model.dNr, model.dNs, model.wq,
+                              model.tz, model.wt, 1.0, False, mt, mr)
+        masses.append(mr)
+    assert masses[1].min() > 0.0
+    np.testing.assert_allclose(masses[0], masses[1], rtol=1e-12)
+    np.testing.assert_allclose(masses[2], masses[1], rtol=1e-12)

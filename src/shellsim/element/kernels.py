@@ -432,16 +432,14 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
            + Fl[0, 2] * (Fl[1, 0] * Fl[2, 1] - Fl[1, 1] * Fl[2, 0]))
     D = np.zeros((3, 3))
     _strain_tensor(eps, eps0, D)
-    E = np.empty((3, 3))
     for i in range(3):
+        D[i, i] += 0.5  # 1/2 (Fl^T Fl - I) + Fl^T D Fl = Fl^T (D + I/2) Fl - I/2
+    E = np.empty((3, 3))
+    _rotate(Fl.T, D, E)
+    for i in range(3):
+        E[i, i] -= 0.5
         for j in range(3):
-            acc = -0.5 if i == j else 0.0
-            for m in range(3):
-                acc += 0.5 * Fl[m, i] * Fl[m, j]
-                for n in range(3):
-                    acc += Fl[m, i] * D[m, n] * Fl[n, j]
-            E[i, j] = acc
-            Emean[i, j] += share * acc
+            Emean[i, j] += share * E[i, j]
     S = np.empty((3, 3))
     Cinv = np.empty((3, 3))
     p = hyperelastic.stress(law, params, E, S, Cinv)
@@ -463,13 +461,7 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         unit[b] = 1.0
         D[:] = 0.0
         _strain_tensor(unit, np.zeros(5), D)
-        for i in range(3):
-            for j in range(3):
-                acc = 0.0
-                for m in range(3):
-                    for n in range(3):
-                        acc += Fl[m, i] * D[m, n] * Fl[n, j]
-                dE[i, j] = acc
+        _rotate(Fl.T, D, dE)  # pulled back: Fl^T D Fl
         hyperelastic.tangent(law, params, E, Cinv, p, dE, dS)
         _push_forward(Fl, dS, det, tmp, col)
         for a in range(5):
@@ -490,13 +482,7 @@ def _follow_material_spin(s5, L, q, g, Ll):
     (a x L a) . e3 for a unit a; the stresses turn by the difference, exactly as a
     rotation. L (3, 3): the step's displacement gradient (global); q (3, 3): lamina
     frame; g (2, 3): g_r, g_s; Ll (3, 3) scratch."""
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for m in range(3):
-                for n in range(3):
-                    acc += q[i, m] * L[m, n] * q[j, n]
-            Ll[i, j] = acc
+    _rotate(q, L, Ll)
     spin = 0.5 * (Ll[1, 0] - Ll[0, 1])
     frame = 0.0
     for a in range(2):

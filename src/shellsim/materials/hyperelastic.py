@@ -45,11 +45,17 @@ LINEAR, MOONEY_RIVLIN, GUCCIONE, ST_VENANT_KIRCHHOFF = -1, 0, 1, 2
 
 
 @njit(cache=True)
-def _weights(params, b):
-    """Guccione's b_ij (3, 3) from params (C1, C2, C3, C4)."""
+def _guccione_exponent(params, E, b):
+    """Q = sum_ij b_ij E_ij^2 of E (3, 3); fills Guccione's weights b (3, 3) from params
+    (C1, C2, C3, C4)."""
     b[0, 0] = params[1]
     b[1, 1] = b[2, 2] = b[1, 2] = b[2, 1] = params[2]
     b[0, 1] = b[1, 0] = b[0, 2] = b[2, 0] = params[3]
+    Q = 0.0
+    for i in range(3):
+        for j in range(3):
+            Q += b[i, j] * E[i, j] * E[i, j]
+    return Q
 
 
 @njit(cache=True)
@@ -58,12 +64,7 @@ def strain_energy(law, params, E):
     applied here (tests use it to check the stresses)."""
     if law == GUCCIONE:
         b = np.empty((3, 3))
-        _weights(params, b)
-        Q = 0.0
-        for i in range(3):
-            for j in range(3):
-                Q += b[i, j] * E[i, j] * E[i, j]
-        return 0.5 * params[0] * (np.exp(Q) - 1.0)
+        return 0.5 * params[0] * (np.exp(_guccione_exponent(params, E, b)) - 1.0)
     if law == ST_VENANT_KIRCHHOFF:
         trace = E[0, 0] + E[1, 1] + E[2, 2]
         energy = 0.5 * params[0] * trace * trace
@@ -87,12 +88,7 @@ def _energy_stress(law, params, E, S):
     """S^w = dW/dE (3, 3) at E, without the constraint's pressure."""
     if law == GUCCIONE:
         b = np.empty((3, 3))
-        _weights(params, b)
-        Q = 0.0
-        for i in range(3):
-            for j in range(3):
-                Q += b[i, j] * E[i, j] * E[i, j]
-        scale = params[0] * np.exp(Q)
+        scale = params[0] * np.exp(_guccione_exponent(params, E, b))
         for i in range(3):
             for j in range(3):
                 S[i, j] = scale * b[i, j] * E[i, j]
@@ -112,14 +108,11 @@ def _energy_tangent(law, params, E, dE, dS):
     """dS^w = CC^w : dE (3, 3), the directional derivative of :func:`_energy_stress`."""
     if law == GUCCIONE:
         b = np.empty((3, 3))
-        _weights(params, b)
-        Q = 0.0
+        scale = params[0] * np.exp(_guccione_exponent(params, E, b))
         dQ = 0.0
         for i in range(3):
             for j in range(3):
-                Q += b[i, j] * E[i, j] * E[i, j]
                 dQ += 2.0 * b[i, j] * E[i, j] * dE[i, j]
-        scale = params[0] * np.exp(Q)
         for i in range(3):
             for j in range(3):
                 dS[i, j] = scale * b[i, j] * (dE[i, j] + E[i, j] * dQ)

@@ -696,11 +696,13 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
     With Techniques 2 and 3 (INCREMENTAL mode, ``params[0]`` = 2 or 3), the fibre lengths
-    are scaled each step by 1 + the step's mean normal strain increment (thesis Eq 3.33).
-    With a hyperelastic law in TOTAL mode, also the fibre-length update (thesis 3.11):
-    the normal stretch of the integration points, averaged to the nodes with weights
-    sum_p N_a^2 dv (positive, as M1's), scales the initial fibre lengths, h = h0 lambda_3,
-    one step behind the kinematics as in the thesis. The stresses of a hyperelastic law
+    are scaled each step by 1 + the step's normal strain increment (thesis Eq 3.33); with
+    a hyperelastic law in TOTAL mode the initial ones by the normal stretch, h = h0
+    lambda_3 (thesis 3.11), one step behind the kinematics as in the thesis. Either factor
+    is the element's volume mean, and a node takes the volume-weighted mean of its
+    elements': averaged from the integration points with weights N_a dv, or N_a^2 dv, the
+    nodal lengths of a refined holed sheet (Techniques 2, 3) grew a pattern inside the
+    elements next to the hole that broke the run down. The stresses of a hyperelastic law
     are computed on the initial fibre lengths: J = 1 fixes the thickness strain anyway,
     and with the current ones a node-to-node difference in h tilts the layers, strains
     them and feeds back into lambda_3 (a loop no energy stands behind, which broke Test 10
@@ -742,13 +744,17 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
                 f[node, i] += fe[a, i]
                 g[node, i] += ge[a, i]
         if update:
+            vol = 0.0
+            mean = 0.0
             for p in range(nq):
                 dv = 0.0
                 for k in range(tz.shape[0]):
                     dv += DV[p, k]
-                for a in range(9):
-                    weighted[conn[e, a]] += N[p, a] * N[p, a] * dv * stretch[p]
-                    weights[conn[e, a]] += N[p, a] * N[p, a] * dv
+                vol += dv
+                mean += dv * stretch[p]
+            for a in range(9):
+                weighted[conn[e, a]] += mean
+                weights[conn[e, a]] += vol
     _to_rotational(g, d, e1, fr)
     if update:
         for node in range(nn):

@@ -181,27 +181,25 @@ def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, 
     """
     material, section = deck.material, deck.section
     h0 = mesh.thickness.copy()
+    no_axes = np.zeros((1, len(N), len(tz), 3, 3))  # the kernels index it only for Technique 1
     if not material.HYPERELASTIC and section.technique is None:
-        unused = np.zeros((1, len(N), len(tz), 3, 3))
         return (reduced_lamina_matrix(material.E, material.nu, section.plane_strain),
-                (hyperelastic.LINEAR, np.zeros(4), unused, h0, False))
+                (hyperelastic.LINEAR, np.zeros(4), no_axes, h0, False))
     if section.plane_strain:
         raise NotYetAvailable("section.plane_strain with a large-strain technique is not available; "
                               "plane strain is a small-strain section (Test 7)")
     if not material.HYPERELASTIC and section.technique in (2, 3):
         # constant tensor, stresses accumulated in the lamina frame from each step's
         # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
-        unused = np.zeros((1, len(N), len(tz), 3, 3))
         ratio = material.nu / (1.0 - material.nu)
         return (reduced_lamina_matrix(material.E, material.nu),
-                (hyperelastic.LINEAR, np.array([float(section.technique), ratio, 0.0, 0.0]), unused, h0,
+                (hyperelastic.LINEAR, np.array([float(section.technique), ratio, 0.0, 0.0]), no_axes, h0,
                  deck.thickness_update))
     if section.technique not in (None, 1):
         raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
                               "Technique 1; Techniques 2 and 3 take a linear elastic material")
-    if section.formulation != "total" or section.plane_strain:
-        raise NotYetAvailable("Technique 1 runs in the total formulation with zero normal stress "
-                              "(section.formulation = 'total', plane_strain = false)")
+    if section.formulation != "total":
+        raise NotYetAvailable("Technique 1 runs in the total formulation (section.formulation = 'total')")
     if material.model == "linear_elastic":
         lam = material.E * material.nu / ((1 + material.nu) * (1 - 2 * material.nu))
         law, params = hyperelastic.ST_VENANT_KIRCHHOFF, [lam, material.E / (2 * (1 + material.nu)), SHEAR_FACTOR, 0.0]

@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from ..materials import hyperelastic
+from ..tensor3 import congruence, det3
 from .frames import lamina_frame
 
 
@@ -49,9 +50,7 @@ def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
             jac[i, 0] += dNr[a] * pos
             jac[i, 1] += dNs[a] * pos
             jac[i, 2] += N[a] * half * de[a, i]
-    det = (jac[0, 0] * (jac[1, 1] * jac[2, 2] - jac[1, 2] * jac[2, 1])
-           - jac[0, 1] * (jac[1, 0] * jac[2, 2] - jac[1, 2] * jac[2, 0])
-           + jac[0, 2] * (jac[1, 0] * jac[2, 1] - jac[1, 1] * jac[2, 0]))
+    det = det3(jac)
     jinv[0, 0] = (jac[1, 1] * jac[2, 2] - jac[1, 2] * jac[2, 1]) / det
     jinv[0, 1] = (jac[0, 2] * jac[2, 1] - jac[0, 1] * jac[2, 2]) / det
     jinv[0, 2] = (jac[0, 1] * jac[1, 2] - jac[0, 2] * jac[1, 1]) / det
@@ -153,9 +152,7 @@ def _almansi(F, eg, B):
     for i in range(3):
         for j in range(i, 3):
             B[i, j] = B[j, i] = F[i, 0] * F[j, 0] + F[i, 1] * F[j, 1] + F[i, 2] * F[j, 2]
-    det = (B[0, 0] * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1])
-           - B[0, 1] * (B[1, 0] * B[2, 2] - B[1, 2] * B[2, 0])
-           + B[0, 2] * (B[1, 0] * B[2, 1] - B[1, 1] * B[2, 0]))
+    det = det3(B)
     eg[0, 0] = 0.5 - 0.5 * (B[1, 1] * B[2, 2] - B[1, 2] * B[2, 1]) / det
     eg[1, 1] = 0.5 - 0.5 * (B[0, 0] * B[2, 2] - B[0, 2] * B[2, 0]) / det
     eg[2, 2] = 0.5 - 0.5 * (B[0, 0] * B[1, 1] - B[0, 1] * B[1, 0]) / det
@@ -209,8 +206,11 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, VR) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, VR, M3) = work
     hyper = law != hyperelastic.LINEAR
+    # the field's (or the step's) gradient serves the initial-stress stiffness (LINEAR) and
+    # the spin correction of Techniques 2 and 3
+    keep_gradient = mode == LINEAR or (mode == INCREMENTAL and params[0] > 0.0)
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -235,8 +235,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         for m in range(3):
                             acc += jac[i, m] * jac0_inv[p, k, m, j]
                         F[i, j] = acc
-                        if p < nq:
-                            FP[p, k, i, j] = acc
+                if hyper and p < nq:
+                    FP[p, k] = F
             if mode == TOTAL:
                 _almansi(F, eg, v)
             else:
@@ -244,8 +244,8 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 for i in range(3):
                     for j in range(3):
                         eg[i, j] = 0.5 * (F[i, j] + F[j, i])
-                        if p < nq:
-                            LP[p, k, i, j] = F[i, j]  # the step's (or the field's) displacement gradient
+                if keep_gradient and p < nq:
+                    LP[p, k] = F
             _global_to_lamina_strain(eg, q, EPS[p, k], v)
             if hyper and p < nq:
                 EPS0[p, k] = EPS[p, k]
@@ -303,12 +303,12 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
             VR[p, k] = 1.0
             if hyper and mode == TOTAL:
                 volume_ratio = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k],
-                                                   stress[p, k], Ct, False, Emean, wt[k] / wsum)
+                                                   stress[p, k], Ct, False, Emean, wt[k] / wsum, M3, s5)
             elif hyper:  # LINEAR: the tangent at the current state times the field's strain
                 # the tangent is per kinematic volume; the initial-stress term below takes the
                 # true one, as the stress it comes from
                 VR[p, k] = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k],
-                                               s5, Ct, True, Emean, 0.0)
+                                               s5, Ct, True, Emean, 0.0, M3, s5)
                 for i in range(5):
                     acc = 0.0
                     for j in range(5):
@@ -327,7 +327,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                     normal = -params[1] * (EPS[p, k, 0] + EPS[p, k, 1])
                     stretch[p] += wt[k] / wsum * normal
                     if params[0] == 2.0:
-                        _convect(stress[p, k], EPS[p, k], normal, local, glob)
+                        _convect(stress[p, k], EPS[p, k], normal, local, glob, eg)
                     _follow_material_spin(stress[p, k], LP[p, k], Q[p, k], G[p, k], local)
             for i in range(3):
                 SW[p, k, i] = stress[p, k, i] * DV[p, k] * volume_ratio
@@ -402,7 +402,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
 
 
 @njit(cache=True)
-def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent, Emean, share):
+def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent, Emean, share, M3, v5):
     """Technique 1 at one point (thesis 3.10.1): lamina Cauchy stress out5 (5,) from a
     hyperelastic law, or (want_tangent) its tangent Ct (5, 5) in the current lamina frame.
 
@@ -418,54 +418,36 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     S~_33 = 0, up to transverse shear). The tangent is pushed forward the same way
     (Eq 3.26), column by column for unit lamina strains, per kinematic volume (det Fl).
     Adds share x E (before E33 is solved) to Emean (3, 3), for the fibre's mean strain
-    (Eq 3.31)."""
-    Fl = np.empty((3, 3))
-    tmp = np.empty((3, 3))
+    (Eq 3.31). M3 (8, 3, 3), v5 (5,): scratch."""
+    Fl, D, E, S, Cinv, dE, dS, tmp = M3[0], M3[1], M3[2], M3[3], M3[4], M3[5], M3[6], M3[7]
+    congruence(q, F, R0, Fl)
+    det = det3(Fl)
+    # 1/2 (Fl^T Fl - I) + Fl^T (eps - eps0) Fl = Fl^T (eps - eps0 + I/2) Fl - I/2
+    D[:] = 0.0
+    _add_strain_tensor(eps, 1.0, D)
+    _add_strain_tensor(eps0, -1.0, D)
     for i in range(3):
-        for j in range(3):
-            tmp[i, j] = q[i, 0] * F[0, j] + q[i, 1] * F[1, j] + q[i, 2] * F[2, j]
-    for i in range(3):
-        for j in range(3):
-            Fl[i, j] = tmp[i, 0] * R0[j, 0] + tmp[i, 1] * R0[j, 1] + tmp[i, 2] * R0[j, 2]
-    det = (Fl[0, 0] * (Fl[1, 1] * Fl[2, 2] - Fl[1, 2] * Fl[2, 1])
-           - Fl[0, 1] * (Fl[1, 0] * Fl[2, 2] - Fl[1, 2] * Fl[2, 0])
-           + Fl[0, 2] * (Fl[1, 0] * Fl[2, 1] - Fl[1, 1] * Fl[2, 0]))
-    D = np.zeros((3, 3))
-    _strain_tensor(eps, eps0, D)
-    for i in range(3):
-        D[i, i] += 0.5  # 1/2 (Fl^T Fl - I) + Fl^T D Fl = Fl^T (D + I/2) Fl - I/2
-    E = np.empty((3, 3))
-    _rotate(Fl.T, D, E)
+        D[i, i] += 0.5
+    congruence(Fl.T, D, Fl.T, E)
     for i in range(3):
         E[i, i] -= 0.5
         for j in range(3):
             Emean[i, j] += share * E[i, j]
-    S = np.empty((3, 3))
-    Cinv = np.empty((3, 3))
     p = hyperelastic.stress(law, params, E, S, Cinv)
-    for i in range(3):
-        for j in range(3):
-            tmp[i, j] = 2.0 * E[i, j] + (1.0 if i == j else 0.0)
-    volume = np.sqrt(tmp[0, 0] * (tmp[1, 1] * tmp[2, 2] - tmp[1, 2] * tmp[2, 1])
-                     - tmp[0, 1] * (tmp[1, 0] * tmp[2, 2] - tmp[1, 2] * tmp[2, 0])
-                     + tmp[0, 2] * (tmp[1, 0] * tmp[2, 1] - tmp[1, 1] * tmp[2, 0]))
+    volume = hyperelastic.volume_ratio(law, E)
     if not want_tangent:
         _push_forward(Fl, S, volume, tmp, out5)
         return volume / det
-    unit = np.zeros(5)
-    dE = np.empty((3, 3))
-    dS = np.empty((3, 3))
-    col = np.empty(5)
     for b in range(5):
-        unit[:] = 0.0
-        unit[b] = 1.0
+        v5[:] = 0.0
+        v5[b] = 1.0
         D[:] = 0.0
-        _strain_tensor(unit, np.zeros(5), D)
-        _rotate(Fl.T, D, dE)  # pulled back: Fl^T D Fl
+        _add_strain_tensor(v5, 1.0, D)
+        congruence(Fl.T, D, Fl.T, dE)  # pulled back: Fl^T D Fl
         hyperelastic.tangent(law, params, E, Cinv, p, dE, dS)
-        _push_forward(Fl, dS, det, tmp, col)
+        _push_forward(Fl, dS, det, tmp, v5)
         for a in range(5):
-            Ct[a, b] = col[a]
+            Ct[a, b] = v5[a]
     return volume / det
 
 
@@ -502,52 +484,48 @@ def _follow_material_spin(s5, L, q, g, Ll):
 
 
 @njit(cache=True)
-def _convect(s5, e5, normal, M, out):
+def _convect(s5, e5, normal, M, T, out):
     """Technique 2's push-forward of the accumulated stress (thesis Eqs 3.29-3.30) over
     one step: sigma <- M sigma M / det M, M = I + the step's lamina strain increment
     e5 (11, 22, 2x12, 2x13, 2x23) with its normal part ``normal`` (zero normal stress).
-    Only the stretch is applied: the lamina frame already turns with the body. M, out
+    Only the stretch is applied: the lamina frame already turns with the body. M, T, out
     (3, 3) scratch; s5 (5,) updated."""
     M[:] = 0.0
-    _strain_tensor(e5, np.zeros(5), M)
+    _add_strain_tensor(e5, 1.0, M)
     M[2, 2] = normal
     for i in range(3):
         M[i, i] += 1.0
-    det = (M[0, 0] * (M[1, 1] * M[2, 2] - M[1, 2] * M[2, 1]) - M[0, 1] * (M[1, 0] * M[2, 2] - M[1, 2] * M[2, 0])
-           + M[0, 2] * (M[1, 0] * M[2, 1] - M[1, 1] * M[2, 0]))
-    out[:] = 0.0
-    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
-        out[i, j] = out[j, i] = s5[c]
-    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
-        acc = 0.0
-        for m in range(3):
-            for n in range(3):
-                acc += M[i, m] * out[m, n] * M[n, j]
-        s5[c] = acc / det
+    T[:] = 0.0
+    T[0, 0], T[1, 1] = s5[0], s5[1]
+    T[0, 1] = T[1, 0] = s5[2]
+    T[0, 2] = T[2, 0] = s5[3]
+    T[1, 2] = T[2, 1] = s5[4]
+    _push_forward(M, T, det3(M), out, s5)
 
 
 @njit(cache=True)
-def _strain_tensor(eps, eps0, D):
-    """D (3, 3) += the lamina tensor of the strain difference eps - eps0 (5,) (engineering
-    shears halved); D[2, 2] untouched."""
-    D[0, 0] += eps[0] - eps0[0]
-    D[1, 1] += eps[1] - eps0[1]
-    D[0, 1] += 0.5 * (eps[2] - eps0[2])
-    D[1, 0] += 0.5 * (eps[2] - eps0[2])
-    D[0, 2] += 0.5 * (eps[3] - eps0[3])
-    D[2, 0] += 0.5 * (eps[3] - eps0[3])
-    D[1, 2] += 0.5 * (eps[4] - eps0[4])
-    D[2, 1] += 0.5 * (eps[4] - eps0[4])
+def _add_strain_tensor(e5, scale, D):
+    """D (3, 3) += scale x the lamina tensor of the strains e5 (11, 22, 2x12, 2x13, 2x23)
+    (engineering shears halved); D[2, 2] untouched."""
+    D[0, 0] += scale * e5[0]
+    D[1, 1] += scale * e5[1]
+    D[0, 1] += 0.5 * scale * e5[2]
+    D[1, 0] += 0.5 * scale * e5[2]
+    D[0, 2] += 0.5 * scale * e5[3]
+    D[2, 0] += 0.5 * scale * e5[3]
+    D[1, 2] += 0.5 * scale * e5[4]
+    D[2, 1] += 0.5 * scale * e5[4]
 
 
 @njit(cache=True)
 def _push_forward(Fl, S, det, tmp, out5):
     """Lamina components (11, 22, 12, 13, 23) of Fl S Fl^T / det; tmp (3, 3) scratch."""
-    for i in range(3):
-        for j in range(3):
-            tmp[i, j] = Fl[i, 0] * S[0, j] + Fl[i, 1] * S[1, j] + Fl[i, 2] * S[2, j]
-    for c, (i, j) in enumerate(((0, 0), (1, 1), (0, 1), (0, 2), (1, 2))):
-        out5[c] = (tmp[i, 0] * Fl[j, 0] + tmp[i, 1] * Fl[j, 1] + tmp[i, 2] * Fl[j, 2]) / det
+    congruence(Fl, S, Fl, tmp)
+    out5[0] = tmp[0, 0] / det
+    out5[1] = tmp[1, 1] / det
+    out5[2] = tmp[0, 1] / det
+    out5[3] = tmp[0, 2] / det
+    out5[4] = tmp[1, 2] / det
 
 
 @njit(cache=True)
@@ -655,13 +633,7 @@ def _contract_contravariant(s, jinv, out):
 def _rotate(q, A, out):
     """out = q A q^T, all (3, 3): global tensor to lamina components with q, and back with
     q.T."""
-    for i in range(3):
-        for j in range(3):
-            acc = 0.0
-            for k in range(3):
-                for m in range(3):
-                    acc += q[i, k] * A[k, m] * q[j, m]
-            out[i, j] = acc
+    congruence(q, A, q, out)
 
 
 @njit(cache=True)
@@ -675,7 +647,7 @@ def _scratch(npts, nt, nb, nq):
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
             np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
             np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)),
-            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt)))
+            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt)), np.empty((8, 3, 3)))
 
 
 @njit(cache=True)

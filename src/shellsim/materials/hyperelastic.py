@@ -40,21 +40,30 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..tensor3 import congruence
+
 #: Law codes of :func:`stress`; LINEAR marks the small-strain path (no law here).
 LINEAR, MOONEY_RIVLIN, GUCCIONE, ST_VENANT_KIRCHHOFF = -1, 0, 1, 2
 
 
 @njit(cache=True)
-def _guccione_exponent(params, E, b):
-    """Q = sum_ij b_ij E_ij^2 of E (3, 3); fills Guccione's weights b (3, 3) from params
-    (C1, C2, C3, C4)."""
-    b[0, 0] = params[1]
-    b[1, 1] = b[2, 2] = b[1, 2] = b[2, 1] = params[2]
-    b[0, 1] = b[1, 0] = b[0, 2] = b[2, 0] = params[3]
+def _guccione_weight(params, i, j):
+    """Guccione's b_ij from params (C1, C2, C3, C4): C2 along the fibre (11), C4 for the
+    fibre shears (12, 13), C3 for the rest."""
+    if i == 0 and j == 0:
+        return params[1]
+    if i == 0 or j == 0:
+        return params[3]
+    return params[2]
+
+
+@njit(cache=True)
+def _guccione_exponent(params, E):
+    """Q = sum_ij b_ij E_ij^2 of E (3, 3)."""
     Q = 0.0
     for i in range(3):
         for j in range(3):
-            Q += b[i, j] * E[i, j] * E[i, j]
+            Q += _guccione_weight(params, i, j) * E[i, j] * E[i, j]
     return Q
 
 
@@ -63,8 +72,7 @@ def strain_energy(law, params, E):
     """W (per unit initial volume) of the full strain E (3, 3); the constraint is not
     applied here (tests use it to check the stresses)."""
     if law == GUCCIONE:
-        b = np.empty((3, 3))
-        return 0.5 * params[0] * (np.exp(_guccione_exponent(params, E, b)) - 1.0)
+        return 0.5 * params[0] * (np.exp(_guccione_exponent(params, E)) - 1.0)
     if law == ST_VENANT_KIRCHHOFF:
         trace = E[0, 0] + E[1, 1] + E[2, 2]
         energy = 0.5 * params[0] * trace * trace
@@ -87,11 +95,10 @@ def strain_energy(law, params, E):
 def _energy_stress(law, params, E, S):
     """S^w = dW/dE (3, 3) at E, without the constraint's pressure."""
     if law == GUCCIONE:
-        b = np.empty((3, 3))
-        scale = params[0] * np.exp(_guccione_exponent(params, E, b))
+        scale = params[0] * np.exp(_guccione_exponent(params, E))
         for i in range(3):
             for j in range(3):
-                S[i, j] = scale * b[i, j] * E[i, j]
+                S[i, j] = scale * _guccione_weight(params, i, j) * E[i, j]
         return
     if law == ST_VENANT_KIRCHHOFF:
         _svk(params, E, S)
@@ -107,15 +114,14 @@ def _energy_stress(law, params, E, S):
 def _energy_tangent(law, params, E, dE, dS):
     """dS^w = CC^w : dE (3, 3), the directional derivative of :func:`_energy_stress`."""
     if law == GUCCIONE:
-        b = np.empty((3, 3))
-        scale = params[0] * np.exp(_guccione_exponent(params, E, b))
+        scale = params[0] * np.exp(_guccione_exponent(params, E))
         dQ = 0.0
         for i in range(3):
             for j in range(3):
-                dQ += 2.0 * b[i, j] * E[i, j] * dE[i, j]
+                dQ += 2.0 * _guccione_weight(params, i, j) * E[i, j] * dE[i, j]
         for i in range(3):
             for j in range(3):
-                dS[i, j] = scale * b[i, j] * (dE[i, j] + E[i, j] * dQ)
+                dS[i, j] = scale * _guccione_weight(params, i, j) * (dE[i, j] + E[i, j] * dQ)
         return
     if law == ST_VENANT_KIRCHHOFF:
         _svk(params, dE, dS)
@@ -150,18 +156,28 @@ def normal_strain(law, params, E):
 
 
 @njit(cache=True)
-def _inverse_sym(C, out):
-    """Inverse of a symmetric (3, 3) C into out; returns det C."""
-    det = (C[0, 0] * (C[1, 1] * C[2, 2] - C[1, 2] * C[2, 1])
-           - C[0, 1] * (C[1, 0] * C[2, 2] - C[1, 2] * C[2, 0])
-           + C[0, 2] * (C[1, 0] * C[2, 1] - C[1, 1] * C[2, 0]))
-    out[0, 0] = (C[1, 1] * C[2, 2] - C[1, 2] * C[2, 1]) / det
-    out[1, 1] = (C[0, 0] * C[2, 2] - C[0, 2] * C[2, 0]) / det
-    out[2, 2] = (C[0, 0] * C[1, 1] - C[0, 1] * C[1, 0]) / det
-    out[0, 1] = out[1, 0] = (C[0, 2] * C[2, 1] - C[0, 1] * C[2, 2]) / det
-    out[0, 2] = out[2, 0] = (C[0, 1] * C[1, 2] - C[0, 2] * C[1, 1]) / det
-    out[1, 2] = out[2, 1] = (C[0, 2] * C[1, 0] - C[0, 0] * C[1, 2]) / det
-    return det
+def volume_ratio(law, E):
+    """J = sqrt(det(2E + I)) of a solved strain: 1 for the incompressible laws (the
+    constraint made it so), computed for St. Venant-Kirchhoff."""
+    if law != ST_VENANT_KIRCHHOFF:
+        return 1.0
+    c11, c22, c33 = 1.0 + 2.0 * E[0, 0], 1.0 + 2.0 * E[1, 1], 1.0 + 2.0 * E[2, 2]
+    c12, c13, c23 = 2.0 * E[0, 1], 2.0 * E[0, 2], 2.0 * E[1, 2]
+    return np.sqrt(c11 * (c22 * c33 - c23 * c23) - c12 * (c12 * c33 - c23 * c13) + c13 * (c12 * c23 - c22 * c13))
+
+
+@njit(cache=True)
+def _inverse_stretch(E, out):
+    """out = (2E + I)^-1 for a solved strain E (3, 3) of an incompressible law, whose
+    determinant is 1: the inverse is the adjugate."""
+    c11, c22, c33 = 1.0 + 2.0 * E[0, 0], 1.0 + 2.0 * E[1, 1], 1.0 + 2.0 * E[2, 2]
+    c12, c13, c23 = 2.0 * E[0, 1], 2.0 * E[0, 2], 2.0 * E[1, 2]
+    out[0, 0] = c22 * c33 - c23 * c23
+    out[1, 1] = c11 * c33 - c13 * c13
+    out[2, 2] = c11 * c22 - c12 * c12
+    out[0, 1] = out[1, 0] = c13 * c23 - c12 * c33
+    out[0, 2] = out[2, 0] = c12 * c23 - c13 * c22
+    out[1, 2] = out[2, 1] = c12 * c13 - c11 * c23
 
 
 @njit(cache=True)
@@ -182,7 +198,8 @@ def stress(law, params, E, S, Cinv):
     """Second Piola stress S~ (3, 3) under zero normal stress, in the material frame.
 
     E (3, 3): strain with any E33; E33 is replaced by the incompressible solution. Writes
-    S (S33 = 0) and Cinv (3, 3), (2E + I)^-1. Returns the pressure p (the constraint's
+    S (S33 = 0) and Cinv (3, 3), (2E + I)^-1 (zeros for St. Venant-Kirchhoff, whose
+    tangent needs none). Returns the pressure p (the constraint's
     Lagrange multiplier; 0 for St. Venant-Kirchhoff, which has none)."""
     normal_strain(law, params, E)
     if law == ST_VENANT_KIRCHHOFF:
@@ -190,11 +207,7 @@ def stress(law, params, E, S, Cinv):
         S[2, 2] = 0.0
         Cinv[:] = 0.0
         return 0.0
-    C = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = 2.0 * E[i, j] + (1.0 if i == j else 0.0)
-    _inverse_sym(C, Cinv)
+    _inverse_stretch(E, Cinv)
     _energy_stress(law, params, E, S)
     p = S[2, 2] / Cinv[2, 2]
     for i in range(3):
@@ -219,17 +232,11 @@ def tangent(law, params, E, Cinv, p, dE, dS):
             if i != 2 or j != 2:
                 acc += Cinv[i, j] * dE[i, j]
     dE[2, 2] = -acc / Cinv[2, 2]
-    dCinv = np.empty((3, 3))
-    tmp = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            tmp[i, j] = Cinv[i, 0] * dE[0, j] + Cinv[i, 1] * dE[1, j] + Cinv[i, 2] * dE[2, j]
-    for i in range(3):
-        for j in range(3):
-            dCinv[i, j] = -2.0 * (tmp[i, 0] * Cinv[0, j] + tmp[i, 1] * Cinv[1, j] + tmp[i, 2] * Cinv[2, j])
+    CdC = np.empty((3, 3))  # dCinv = -2 Cinv dE Cinv
+    congruence(Cinv, dE, Cinv, CdC)
     _energy_tangent(law, params, E, dE, dS)
-    dp = (dS[2, 2] - p * dCinv[2, 2]) / Cinv[2, 2]
+    dp = (dS[2, 2] + 2.0 * p * CdC[2, 2]) / Cinv[2, 2]
     for i in range(3):
         for j in range(3):
-            dS[i, j] -= dp * Cinv[i, j] + p * dCinv[i, j]
+            dS[i, j] -= dp * Cinv[i, j] - 2.0 * p * CdC[i, j]
     dS[2, 2] = 0.0

@@ -17,7 +17,7 @@ from ..deck import Deck
 from ..element.sampling import global_stress, nearest_integration_point
 from ..errors import NotYetAvailable, NumericalError
 from ..mesh import Mesh
-from ..model import Model
+from ..model import FACES, Model
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
 from .simulation import Simulation
 
@@ -134,8 +134,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
             continue
         if p.quantity not in NODAL_QUANTITIES:
             raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
-        face = {"bottom": -1.0, "mid": 0.0, "top": 1.0}[p.face]
-        probes.append(Probe(p.name, p.quantity, p.component, nodes, face=face))
+        probes.append(Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face]))
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
     return run

@@ -206,7 +206,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
     """
     (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, VR, M3) = work
+     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, M3) = work
     hyper = law != hyperelastic.LINEAR
     # the field's (or the step's) gradient serves the initial-stress stiffness (LINEAR) and
     # the spin correction of Techniques 2 and 3
@@ -299,16 +299,13 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
         if mode == INCREMENTAL and params[0] > 0.0:
             stretch[p] = 1.0
         for k in range(nt):
-            volume_ratio = 1.0  # true volume over the kinematic one, at which DV was taken
-            VR[p, k] = 1.0
             if hyper and mode == TOTAL:
-                volume_ratio = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k],
-                                                   stress[p, k], Ct, False, Emean, wt[k] / wsum, M3, s5)
+                # DV was taken on the initial fibre lengths; from here on it is the true volume
+                DV[p, k] *= _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS[p, k], EPS0[p, k],
+                                                stress[p, k], Ct, False, Emean, wt[k] / wsum, M3, s5)
             elif hyper:  # LINEAR: the tangent at the current state times the field's strain
-                # the tangent is per kinematic volume; the initial-stress term below takes the
-                # true one, as the stress it comes from
-                VR[p, k] = _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k],
-                                               s5, Ct, True, Emean, 0.0, M3, s5)
+                DV[p, k] *= _hyperelastic_point(law, params, axes0[p, k], Q[p, k], FP[p, k], EPS0[p, k], EPS0[p, k],
+                                                s5, Ct, True, Emean, 0.0, M3, s5)
                 for i in range(5):
                     acc = 0.0
                     for j in range(5):
@@ -330,7 +327,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         _convect(stress[p, k], EPS[p, k], normal, local, glob, eg)
                     _follow_material_spin(stress[p, k], LP[p, k], Q[p, k], G[p, k], local)
             for i in range(3):
-                SW[p, k, i] = stress[p, k, i] * DV[p, k] * volume_ratio
+                SW[p, k, i] = stress[p, k, i] * DV[p, k]
         if hyper and mode == TOTAL:
             # normal stretch of the fibre's mean strain: the layers' bending parts cancel
             stretch[p] = hyperelastic.normal_strain(law, params, Emean)
@@ -398,7 +395,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         for m in range(3):
                             acc += LP[p, k, i, m] * sg[m, j]
                         eg[i, j] = acc
-                _accumulate(eg, GN[p, k], GM[p, k], DV[p, k] * VR[p, k], fe, ge)
+                _accumulate(eg, GN[p, k], GM[p, k], DV[p, k], fe, ge)
 
 
 @njit(cache=True)
@@ -413,10 +410,10 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     normal stress (Eq 3.28), S~ from the law, and the Cauchy stress is its push-forward
     Fl S~ Fl^T / J in lamina components (Eq 3.27), J = sqrt(det(2E + I)) the true volume
     ratio (1 when incompressible). F is taken on the initial fibre lengths, so det Fl is
-    not J: the return value J / det Fl scales the point's volume for the virtual work
-    (Fl S~ Fl^T, the Kirchhoff stress, does not depend on Fl's normal column while
-    S~_33 = 0, up to transverse shear). The tangent is pushed forward the same way
-    (Eq 3.26), column by column for unit lamina strains, per kinematic volume (det Fl).
+    not J: the return value J / det Fl turns the point's volume into the true one, which
+    every term of the virtual work then takes (Fl S~ Fl^T, the Kirchhoff stress, does not
+    depend on Fl's normal column while S~_33 = 0, up to transverse shear). The tangent is
+    pushed forward the same way (Eq 3.26), column by column for unit lamina strains.
     Adds share x E (before E33 is solved) to Emean (3, 3), for the fibre's mean strain
     (Eq 3.31). M3 (8, 3, 3), v5 (5,): scratch."""
     Fl, D, E, S, Cinv, dE, dS, tmp = M3[0], M3[1], M3[2], M3[3], M3[4], M3[5], M3[6], M3[7]
@@ -445,7 +442,7 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
         _add_strain_tensor(v5, 1.0, D)
         congruence(Fl.T, D, Fl.T, dE)  # pulled back: Fl^T D Fl
         hyperelastic.tangent(law, params, E, Cinv, p, dE, dS)
-        _push_forward(Fl, dS, det, tmp, v5)
+        _push_forward(Fl, dS, volume, tmp, v5)
         for a in range(5):
             Ct[a, b] = v5[a]
     return volume / det
@@ -647,7 +644,7 @@ def _scratch(npts, nt, nb, nq):
             np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
             np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
             np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)),
-            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt)), np.empty((8, 3, 3)))
+            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((8, 3, 3)))
 
 
 @njit(cache=True)

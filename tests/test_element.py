@@ -64,21 +64,31 @@ def interior_nodes(model) -> np.ndarray:
     return np.flatnonzero((y > 1e-9) & (y < 1 - 1e-9) & (left > 1e-9) & (left < 1 - 1e-9))
 
 
-def internal(model, x, d, e1):
+def internal(model, x, d, e1, h=None, step=None, stress=None):
+    """(f, fr, stress) at positions x, directors d, fibre frames e1. h: fibre lengths (a
+    copy of the initial ones by default), updated in place when the material asks; step:
+    the last step's translations (incremental formulation), with ``stress`` carried."""
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
-    stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-    kernels.internal_forces(x, d, model.h0, e1, model.conn, model.N, model.dNr, model.dNs, model.tie, model.tie_points, model.wq,
-                            model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material, False, x * 0, x * 0, stress, f, fr)
+    if stress is None:
+        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
+    kernels.internal_forces(x, d, model.h0.copy() if h is None else h, e1, model.conn, model.N, model.dNr, model.dNs,
+                            model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C,
+                            model.vol_basis, model.material, step is not None, x * 0 if step is None else step, x * 0,
+                            stress, f, fr)
     return f, fr, stress
 
 
-def stiffness(model, vu, vr):
+def stiffness(model, vu, vr, x=None, stress=None):
+    """K v at positions x (the initial ones by default) under the current stress (none by
+    default)."""
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
-    kernels.stiffness_product(model.x0, model.d0, model.h0, model.e1f0, model.conn, model.N, model.dNr,
-                              model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material,
-                              np.zeros((model.n_elements, len(model.wq), len(model.tz), 5)), vu, vr, f, fr)
+    if stress is None:
+        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
+    kernels.stiffness_product(model.x0 if x is None else x, model.d0, model.h0, model.e1f0, model.conn, model.N,
+                              model.dNr, model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt,
+                              model.jac0_inv, model.C, model.vol_basis, model.material, stress, vu, vr, f, fr)
     return f, fr
 
 
@@ -285,13 +295,7 @@ def test_only_rigid_motions_have_zero_energy(geometry, divisions):
 def hyperelastic_state(model, x, d, e1):
     """(lamina stresses (ne, nq, nt, 5), updated fibre lengths (n,)) at positions x."""
     h = model.h0.copy()
-    n = model.n_nodes
-    f, fr = np.zeros((n, 3)), np.zeros((n, 2))
-    stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-    kernels.internal_forces(x, d, h, e1, model.conn, model.N, model.dNr, model.dNs, model.tie, model.tie_points,
-                            model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis, model.material,
-                            False, f * 0, f * 0, stress, f, fr)
-    return stress, h
+    return internal(model, x, d, e1, h=h)[2], h
 
 
 def test_hyperelastic_stress_ignores_a_rigid_rotation():
@@ -361,15 +365,11 @@ def test_constant_tensor_techniques_follow_their_exact_homogeneous_response(tech
     }
     for case, lateral, normal in (("uniaxial", -nu, -nu), ("equibiaxial", 1.0, -2 * nu / (1 - nu))):
         h = model.h0.copy()
-        n = model.n_nodes
-        f, fr = np.zeros((n, 3)), np.zeros((n, 2))
         stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
         previous = model.x0.copy()
         for x in np.linspace(0.0, x_end, steps + 1)[1:]:
             current = model.x0 * [np.exp(x), np.exp(lateral * x), 1.0]
-            kernels.internal_forces(current, model.d0, h, model.e1f0, model.conn, model.N, model.dNr, model.dNs,
-                                    model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C,
-                                    model.vol_basis, model.material, True, current - previous, 0 * current, stress, f, fr)
+            internal(model, current, model.d0, model.e1f0, h=h, step=current - previous, stress=stress)
             previous = current
         s11, s22, s12 = stress[..., 0], stress[..., 1], stress[..., 2]
         mean, radius = 0.5 * (s11 + s22), np.sqrt(0.25 * (s11 - s22) ** 2 + s12**2)
@@ -390,21 +390,12 @@ def test_tangent_with_initial_stress_is_the_derivative_of_the_force_when_stretch
     vr = np.zeros((model.n_nodes, 2))
 
     def force(positions):
-        h = model.h0.copy()
-        f, fr = np.zeros((model.n_nodes, 3)), np.zeros((model.n_nodes, 2))
-        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-        kernels.internal_forces(positions, model.d0, h, model.e1f0, model.conn, model.N, model.dNr, model.dNs,
-                                model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C,
-                                model.vol_basis, model.material, False, f * 0, f * 0, stress, f, fr)
-        return f, stress
+        return internal(model, positions, model.d0, model.e1f0)[0]
 
-    _, stress = force(x)
+    stress = internal(model, x, model.d0, model.e1f0)[2]
     eps = 1e-6
-    derivative = (force(x + eps * vu)[0] - force(x - eps * vu)[0]) / (2 * eps)
-    f, fr = np.zeros((model.n_nodes, 3)), np.zeros((model.n_nodes, 2))
-    kernels.stiffness_product(x, model.d0, model.h0, model.e1f0, model.conn, model.N, model.dNr, model.dNs, model.tie,
-                              model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C, model.vol_basis,
-                              model.material, stress, vu, vr, f, fr)
+    derivative = (force(x + eps * vu) - force(x - eps * vu)) / (2 * eps)
+    f, _ = stiffness(model, vu, vr, x=x, stress=stress)
     np.testing.assert_allclose(f, derivative, atol=1e-7 * np.abs(derivative).max())
 
 

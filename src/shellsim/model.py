@@ -217,18 +217,16 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     lamina (circumferential about ``axes.axis`` for cylindrical axes, ``axes.direction``
     for fixed ones, g_r for an isotropic law or where the preferred direction is normal
     to the lamina, e.g. on a tube's axis), a2 = a3 x a1."""
-    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     for k, t in enumerate(tz):
-        pos = xe + t * fe
-        g_r, g_s = np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos)
+        position, jac = _layer_geometry(mesh, N, dNr, dNs, t)
+        g_r, g_s = jac[..., 0], jac[..., 1]
         normal = np.cross(g_r, g_s)
         normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
         if axes is None:
             preferred = g_r
         elif axes.kind == "cylindrical":
-            point = np.einsum("qa,eai->eqi", N, pos) - np.asarray(axes.origin)
-            preferred = np.cross(np.asarray(axes.axis, dtype=float), point)
+            preferred = np.cross(np.asarray(axes.axis, dtype=float), position - np.asarray(axes.origin))
         else:
             preferred = np.broadcast_to(np.asarray(axes.direction, dtype=float), g_r.shape)
         a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
@@ -255,15 +253,21 @@ def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(rs)), rs])
 
 
+def _layer_geometry(mesh: Mesh, N, dNr, dNs, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Initial positions (ne, q, 3) and Jacobians dy/d(r, s, t) (ne, q, 3, 3, columns) of
+    the points (N, dNr, dNs: (q, 9)) on the layer at thickness coordinate t."""
+    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
+    pos = xe + t * fe
+    jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
+                    np.einsum("qa,eai->eqi", N, fe)], axis=-1)
+    return np.einsum("qa,eai->eqi", N, pos), jac
+
+
 def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) inverses of dy/d(r, s, t) on the initial configuration."""
-    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     for k, t in enumerate(tz):
-        pos = xe + t * fe
-        jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
-                        np.einsum("qa,eai->eqi", N, fe)], axis=-1)  # columns d/dr, d/ds, d/dt
-        out[:, :, k] = np.linalg.inv(jac)
+        out[:, :, k] = np.linalg.inv(_layer_geometry(mesh, N, dNr, dNs, t)[1])
     return out
 
 

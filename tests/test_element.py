@@ -10,7 +10,7 @@ import pytest
 from shellsim.deck import parse_deck
 from shellsim.element import kernels
 from shellsim.element.frames import rotate_director
-from shellsim.element.sampling import global_stress, nearest_integration_point
+from shellsim.element.sampling import nearest_integration_point, point_tensors
 from shellsim.geometry import build_mesh
 from shellsim.mesh import Mesh, averaged_directors
 from shellsim.model import build_model
@@ -195,20 +195,38 @@ def test_membrane_patch_test_on_a_skewed_mesh():
 
 
 @pytest.mark.parametrize("turn", [0.0, 0.5 * np.pi, 2.0])
-def test_global_stress_at_a_point_is_the_plane_stress_law_in_global_axes(turn):
-    """The stress probe's reading (lamina stress turned by the lamina frame) on the
-    stretched skewed patch, and on the same state turned rigidly about z by ``turn``:
-    R sigma R^T with sigma the plane-stress law of STRAIN in x, y."""
+def test_point_tensors_are_the_plane_stress_law_and_the_exact_strain_in_global_axes(turn):
+    """The tensors written to probes and frames (lamina stress turned by the lamina frame;
+    Green-Lagrange strain from the geometry) on the stretched skewed patch, and on the same
+    state turned rigidly about z by ``turn``: R sigma R^T with sigma the plane-stress law of
+    STRAIN in x, y at every point; E = (F^T F - I) / 2 with F = R (I + STRAIN), unchanged by
+    the rotation."""
     model = square_patch(skew=0.3)
     R = rotation(np.array([0.0, 0.0, 1.0]), turn)
-    x = (model.x0 + model.x0 @ STRAIN.T) @ R.T
-    _, _, stress = internal(model, x, model.d0 @ R.T, model.e1f0 @ R.T)
+    x, d = (model.x0 + model.x0 @ STRAIN.T) @ R.T, model.d0 @ R.T
+    _, _, stress = internal(model, x, d, model.e1f0 @ R.T)
     law = model.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     sigma = np.array([[law[0], law[2], 0.0], [law[2], law[1], 0.0], [0.0, 0.0, 0.0]])
-    element, point = nearest_integration_point(model.x0, model.conn, model.N[:9], np.array([0.7, 0.2, 0.0]))
-    read = global_stress(x, model.d0 @ R.T, model.h0, model.conn[element], model.N[point], model.dNr[point],
-                         model.dNs[point], model.tz, model.wt, stress[element, point])
-    np.testing.assert_allclose(read, R @ sigma @ R.T, atol=1e-6 * np.abs(law).max())
+    out = [np.empty((model.n_elements, 9, len(model.tz), 3, 3)) for _ in range(3)]
+    point_tensors(x, d, model.h0, model.conn, model.N[:9], model.dNr[:9], model.dNs[:9], model.tz,
+                  model.jac0_inv, stress, *out)
+    lamina, cauchy, green = out
+    np.testing.assert_allclose(cauchy, np.broadcast_to(R @ sigma @ R.T, cauchy.shape), atol=1e-6 * np.abs(law).max())
+    F = np.eye(3) + STRAIN
+    np.testing.assert_allclose(green, np.broadcast_to(0.5 * (F.T @ F - np.eye(3)), green.shape), atol=1e-13)
+    np.testing.assert_allclose(np.einsum("epkii->epk", lamina), np.einsum("epkii->epk", cauchy), atol=1e-9 * np.abs(law).max())
+
+
+def test_rigid_rotation_gives_zero_green_lagrange_strain_everywhere(curved):
+    """A large rigid rotation of the distorted curved element (directors carried along)
+    produces no Green-Lagrange strain at any integration point."""
+    model = curved
+    R = rotation(np.array([0.3, -0.5, 0.8]), 2.4)
+    out = [np.empty((model.n_elements, 9, len(model.tz), 3, 3)) for _ in range(3)]
+    point_tensors(model.x0 @ R.T + [1.0, -2.0, 3.0], model.d0 @ R.T, model.h0, model.conn, model.N[:9],
+                  model.dNr[:9], model.dNs[:9], model.tz, model.jac0_inv,
+                  np.zeros((model.n_elements, 9, len(model.tz), 5)), *out)
+    assert np.abs(out[2]).max() < 1e-12
 
 
 def test_membrane_patch_test_on_general_quadrilaterals_converges():

@@ -1,10 +1,12 @@
-"""Reading the element's integration-point results at a place: which point is nearest to
-a location, and its Cauchy stress in global axes."""
+"""Reading the element's integration-point results: which point is nearest to a location,
+and the stress and strain tensors at every point (for probes and output frames)."""
 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
+from ..tensor3 import congruence
 from .frames import lamina_frame
 
 
@@ -17,24 +19,44 @@ def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndar
     return divmod(flat, len(N_gauss))
 
 
-def global_stress(x: np.ndarray, d: np.ndarray, h: np.ndarray, nodes: np.ndarray, N: np.ndarray,
-                  dNr: np.ndarray, dNs: np.ndarray, tz: np.ndarray, wt: np.ndarray,
-                  stress: np.ndarray) -> np.ndarray:
-    """Thickness mean of the Cauchy stress (3, 3), global axes, at one in-plane point.
+@njit(cache=True)
+def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauchy, green):
+    """Tensors at every integration point (element e, in-plane point q, layer k).
 
-    x, d (n, 3), h (n,): current configuration; nodes (9,): the element's nodes; N, dNr,
-    dNs (9,): shape functions at the point; tz, wt (nt,): thickness rule; stress (nt, 5):
-    the point's lamina stresses (s11, s22, s12, s13, s23), turned by each layer's lamina
-    frame q into q^T sigma q.
+    Inputs: x, d (n, 3), h (n,): current mid-surface, directors, fibre lengths; conn
+    (ne, 9); N, dNr, dNs (nq, 9): shape functions at the in-plane points; tz (nt,): layer
+    coordinates; jac0_inv (ne, >= nq, nt, 3, 3): inverse initial Jacobians; stress
+    (ne, nq, nt, 5): lamina stresses (s11, s22, s12, s13, s23).
+
+    Writes, each (ne, nq, nt, 3, 3): ``lamina``, the stress in the lamina frame (s33 = 0);
+    ``cauchy``, the same turned to global axes (q^T lamina q, q the current lamina frame);
+    ``green``, the Green-Lagrange strain (F^T F - I) / 2 in global axes with
+    F = dx/d(r, s, t) (dX/d(r, s, t))^-1.
     """
-    xe, fe = x[nodes], 0.5 * h[nodes, None] * d[nodes]
     jac, q = np.empty((3, 3)), np.empty((3, 3))
-    out = np.zeros((3, 3))
-    for k, t in enumerate(tz):
-        pos = xe + t * fe
-        jac[:, 0], jac[:, 1], jac[:, 2] = dNr @ pos, dNs @ pos, N @ fe
-        lamina_frame(jac, q)
-        s11, s22, s12, s13, s23 = stress[k]
-        local = np.array([[s11, s12, s13], [s12, s22, s23], [s13, s23, 0.0]])
-        out += wt[k] * (q.T @ local @ q)
-    return out / wt.sum()
+    F, eye = np.empty((3, 3)), np.eye(3)
+    for e in range(conn.shape[0]):
+        for p in range(N.shape[0]):
+            for k in range(tz.shape[0]):
+                jac[:] = 0.0
+                for a in range(9):
+                    node = conn[e, a]
+                    half = 0.5 * h[node]
+                    for i in range(3):
+                        pos = x[node, i] + tz[k] * half * d[node, i]
+                        jac[i, 0] += dNr[p, a] * pos
+                        jac[i, 1] += dNs[p, a] * pos
+                        jac[i, 2] += N[p, a] * half * d[node, i]
+                lamina_frame(jac, q)
+                s11, s22, s12, s13, s23 = stress[e, p, k]
+                local = lamina[e, p, k]
+                local[0, 0], local[0, 1], local[0, 2] = s11, s12, s13
+                local[1, 0], local[1, 1], local[1, 2] = s12, s22, s23
+                local[2, 0], local[2, 1], local[2, 2] = s13, s23, 0.0
+                congruence(q.T, local, q.T, cauchy[e, p, k])
+                congruence(jac, jac0_inv[e, p, k], eye, F)
+                strain = green[e, p, k]
+                congruence(F.T, eye, F.T, strain)
+                for i in range(3):
+                    for j in range(3):
+                        strain[i, j] = 0.5 * (strain[i, j] - eye[i, j])

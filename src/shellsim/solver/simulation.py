@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..element import kernels
+from ..element.sampling import point_tensors
 from ..errors import NumericalError
 from ..model import Model
 from . import explicit
@@ -65,7 +66,7 @@ class Simulation:
         )
         self._eigenvector: np.ndarray | None = None
         self.update_masses()
-        self._forces()
+        self.evaluate_forces()
 
     def update_masses(self) -> None:
         """Lumped masses on the current configuration (M1 or M2, thesis 3.14)."""
@@ -82,6 +83,19 @@ class Simulation:
         kernels.lumped_masses(x, d, h, m.conn, m.N, m.dNr, m.dNs, m.wq, m.tz, m.wt, 1.0, False, mt, mr)
         return float(mt.sum())
 
+    def point_tensors(self, elements=slice(None), points=slice(None)) -> tuple[np.ndarray, ...]:
+        """(lamina stress, global Cauchy stress, Green-Lagrange strain) now at the
+        integration points of ``elements`` and in-plane ``points`` (slices), each
+        (elements, points, nt, 3, 3); see :func:`shellsim.element.sampling.point_tensors`."""
+        m, s = self.model, self.state
+        nq = len(m.wq)
+        conn = m.conn[elements]
+        N, dNr, dNs = m.N[:nq][points], m.dNr[:nq][points], m.dNs[:nq][points]
+        out = [np.empty((len(conn), len(N), len(m.tz), 3, 3)) for _ in range(3)]
+        point_tensors(s.x, s.d, s.h, conn, N, dNr, dNs, m.tz, m.jac0_inv[elements][:, :nq][:, points],
+                      s.stress[elements][:, points], *out)
+        return tuple(out)
+
     def critical_time_step(self) -> float:
         """dt_critical = 2 / omega_max at the current state (warm-started Lanczos)."""
         dt, self._eigenvector = critical_time_step(self, self._eigenvector)
@@ -95,7 +109,8 @@ class Simulation:
                 m.edge_pressure_value, m.edge_pressure_curve, m.curve_t, m.curve_v, m.curve_len,
                 m.curve_interp, m.curve_extrap)
 
-    def _forces(self) -> None:
+    def evaluate_forces(self) -> None:
+        """Internal and external forces and the stresses at the current state and time."""
         s = self.state
         zero = np.zeros_like(s.x)
         explicit.forces(s.t, s.x, s.d, s.h, s.e1, zero, zero, *self._arguments(),

@@ -17,14 +17,13 @@ DEFAULT_DECK = ROOT / "decks" / "artery_inflation.toml"
 def test_help_lists_every_command():
     result = runner.invoke(app, ["--help"])
     assert result.exit_code == 0
-    for command in ("run", "mesh", "check", "render", "report", "bench"):
+    for command in ("run", "mesh", "check", "render", "plot", "report", "bench"):
         assert command in result.output
 
 
-@pytest.mark.parametrize("args", [["render", "results"], ["report", "study.toml"]])
-def test_commands_still_to_come_say_so_and_fail(args, tmp_path, monkeypatch):
+def test_commands_still_to_come_say_so_and_fail(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # nothing may be written into the checkout
-    result = runner.invoke(app, args)
+    result = runner.invoke(app, ["report", "study.toml"])
     assert result.exit_code == 2
     assert "not available yet" in result.output
     assert "Traceback" not in result.output
@@ -75,14 +74,21 @@ def test_mesh_into_an_unwritable_place_is_a_clear_error(tmp_path):
     assert "not writable" in result.output
 
 
+@pytest.mark.parametrize("args", [["render", "nowhere"], ["plot", "nowhere"]])
+def test_render_and_plot_of_a_folder_without_results_is_a_clear_error(args, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert "nowhere" in result.output and "Traceback" not in result.output
+
+
 def test_run_of_the_default_scene_completes_and_reports_its_volume(tmp_path):
-    """The default deck (Guccione aorta, Technique 1) runs; renders it asks for are
-    announced as not available rather than dropped in silence."""
+    """The default deck (Guccione aorta, Technique 1) runs and writes the render it asks for."""
     import json
 
     result = runner.invoke(app, ["run", str(DEFAULT_DECK), "--out", str(tmp_path / "out"), "--quiet"])
     assert result.exit_code == 0, result.output
-    assert "renders of run results are not available yet" in result.output
+    assert list((tmp_path / "out" / "renders").glob("pressure_band_*.png"))
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["status"] == "completed"
     assert abs(summary["volume_change_percent"]) < 1.0

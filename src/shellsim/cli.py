@@ -129,41 +129,54 @@ def run(
     out_dir: Annotated[Path | None, typer.Option("--out", help="Output folder [default: results/DECK-NAME].")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
-    """Integrate a scene in time (explicit central differences): OUT/summary.json and
-    OUT/history.csv. Exit code 1 when a reference check fails, 3 when the run goes unstable."""
+    """Integrate a scene in time (explicit central differences). Writes OUT/summary.json,
+    OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
+    and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
+    reference check fails, 3 when the run goes unstable."""
+    from contextlib import ExitStack, closing
+
     from .deck import load_deck
+    from .deck.resolved import resolved_text
     from .errors import NumericalError
     from .geometry import build_mesh
     from .model import build_model
     from .output.history import HistoryWriter
     from .output.progress import ProgressDisplay
+    from .output.series import FrameWriter, check_space
     from .output.summary import summary, write_json
     from .plan import plan
-    from .solver.run import Listeners, integrate, prepare
+    from .solver.run import Listeners, Timed, integrate, output_times, prepare
 
     scene = load_deck(deck)
-    if scene.output.render:
-        err.print("[yellow]note:[/] output.render: renders of run results are not available yet; "
-                  "the run goes on without them", highlight=False)
     mesh_ = build_mesh(scene, deck.parent)
     current = prepare(scene, mesh_, build_model(scene, mesh_))
     folder = _output_folder(out_dir or Path("results") / deck.stem)  # before any step is taken
-    history = HistoryWriter(folder / "history.csv")
-    progress = ProgressDisplay(out, scene.solver.end_time, quiet)
+    _write_text(folder / "deck.toml", resolved_text(scene, deck, __version__))
     message = None
-    try:
-        integrate(current, Listeners(history, progress))
-    except NumericalError as error:
-        message = str(error)
-    except KeyboardInterrupt:
-        message = "interrupted by the user"
-    finally:
-        progress.close()
-        history.close()
-        result = summary(current, deck, plan(scene), message)
-        write_json(result, folder / "summary.json")
+    with ExitStack() as files:
+        history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))
+        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output)))
+        check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
+        progress = files.enter_context(closing(ProgressDisplay(out, scene.solver.end_time, quiet)))
+        writers = Timed(Listeners(history, frames))
+        try:
+            integrate(current, Listeners(writers, progress))
+        except NumericalError as error:
+            message = str(error)
+        except KeyboardInterrupt:
+            message = "interrupted by the user"
+        except OutputError as error:
+            current.status, message = "output failed", str(error)
+        finally:
+            files.close()
+            result = summary(current, deck, plan(scene), message, writers.seconds)
+            write_json(result, folder / "summary.json")
     if current.status == "interrupted":
         raise KeyboardInterrupt
+    if current.status == "output failed":
+        raise OutputError(message)
+    if current.status == "completed":
+        _deck_renders(scene, folder, quiet)
     if not quiet:
         out.print(_run_report(result, folder))
     if current.status == "unstable":
@@ -171,6 +184,23 @@ def run(
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
+
+
+def _write_text(path: Path, text: str) -> None:
+    try:
+        path.write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+
+
+def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
+    """The renders a deck's [[output.render]] asks for, from the series just written."""
+    from .output.render import render_field
+
+    for picture in scene.output.render:
+        for path in render_field(folder, picture.field, picture.frame, picture.view, picture.size):
+            if not quiet:
+                out.print(f"wrote {path}")
 
 
 def _run_report(result: dict, folder: Path) -> Table | str:
@@ -194,11 +224,65 @@ def _run_report(result: dict, folder: Path) -> Table | str:
     return table
 
 
+def _frame_choice(value: str) -> str | int:
+    if value in ("last", "all"):
+        return value
+    try:
+        return int(value)
+    except ValueError:
+        raise typer.BadParameter(f"expected 'last', 'all' or a frame number, got '{value}'") from None
+
+
+def _size(value: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in value.lower().split("x"))
+    except ValueError:
+        raise typer.BadParameter(f"expected WIDTHxHEIGHT in pixels, e.g. 1200x900, got '{value}'") from None
+    if not (16 <= width <= 8192 and 16 <= height <= 8192):
+        raise typer.BadParameter(f"{width}x{height}: each side must be 16 to 8192 pixels")
+    return width, height
+
+
 @app.command()
 @reports_errors
-def render(results: Annotated[Path, typer.Argument(help="A run's output folder.")]) -> None:
-    """Render a field of a finished run on the deformed shape (PNG)."""
-    _not_yet("'shellsim render' (renders of run results)")
+def render(
+    results: Annotated[Path, typer.Argument(help="A run's output folder.", show_default=False)],
+    field: Annotated[str, typer.Option(help="Field to colour by (as written: pressure_band, von_mises, "
+                                            "cauchy_stress, displacement, thickness, ..._nodal).")] = "pressure_band",
+    component: Annotated[str | None, typer.Option(help="Component of a vector (x, y, z, magnitude) or "
+                                                       "tensor (xx, yy, zz, xy, yz, zx) field.")] = None,
+    frame: Annotated[str, typer.Option(help="'last', 'all' (also an animated GIF) or a frame number "
+                                            "(negative counts from the end).")] = "last",
+    view: Annotated[str, typer.Option(help="iso, top, front or side.")] = "iso",
+    size: Annotated[str, typer.Option(help="Picture size in pixels, WIDTHxHEIGHT.")] = "1200x900",
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Folder for the pictures [default: RESULTS/renders].")] = None,
+) -> None:
+    """Render a field of a run on its deformed shape: off-screen PNGs with a labelled scalar
+    bar, element outlines, and each sub-cell coloured by its integration point's value."""
+    from .output.render import VIEWS, render_field
+
+    if view not in ("iso", *VIEWS):
+        raise typer.BadParameter(f"unknown view '{view}'; expected iso, {', '.join(VIEWS)}", param_hint="--view")
+    if out_dir is not None:
+        _output_folder(out_dir)
+    for path in render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir):
+        out.print(f"wrote {path}")
+
+
+@app.command()
+@reports_errors
+def plot(
+    results: Annotated[Path, typer.Argument(help="A run's output folder.", show_default=False)],
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Folder for the plots [default: RESULTS/plots].")] = None,
+) -> None:
+    """Plot a run's histories: every probe against time (and against the load when a load
+    follows a time curve) with the deck's references, and the energies (PNG)."""
+    from .output.plots import plot_run
+
+    if out_dir is not None:
+        _output_folder(out_dir)
+    for path in plot_run(results, out_dir):
+        out.print(f"wrote {path}")
 
 
 @app.command()

@@ -235,9 +235,10 @@ SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
 
 class Probe(Section):
     """A history written at every output step: ``quantity`` at the node of a point set
-    (a set of several nodes gives their mean). ``stress`` is read at the integration
-    point nearest to the set (mean through the thickness, Cauchy, global axes), as
-    stress benchmarks compare values at Gauss points. ``face`` reads a position or
+    (a set of several nodes gives their mean). ``stress`` (Cauchy), ``strain``
+    (Green-Lagrange) and ``pressure_band`` (-trace(stress) / 3) are read at the integration
+    point nearest to the set (mean through the thickness, global axes), as stress
+    benchmarks compare values at Gauss points. ``face`` reads a position or
     displacement on the bottom or top face (along the director, half the current fibre
     length from the mid-surface), e.g. the inner radius of a vessel."""
 
@@ -270,7 +271,9 @@ class Probe(Section):
 
 
 class Render(Section):
-    """A PNG written at the end of a run."""
+    """PNGs written at the end of a completed run (as ``shellsim render``): ``field``
+    (one of the written ``output.fields``) on the deformed shape, for the ``last`` frame,
+    a frame number, or ``all`` (also an animated GIF), seen from ``view``, ``size`` pixels."""
 
     field: OutputField = "pressure_band"
     frame: Literal["last", "all"] | Count = "last"
@@ -279,8 +282,12 @@ class Render(Section):
 
 
 class Output(Section):
-    """``[output]``: frames every ``interval`` (or at the listed ``times``, which the time
-    stepper lands on exactly), the fields written, the formats, probes and renders."""
+    """``[output]``: frames at t = 0 and every ``interval`` (or at the listed ``times``,
+    which the time stepper lands on exactly) and at the end; the ``fields`` written in
+    them (stresses and strains per integration-point sub-cell, with a smoothed nodal
+    version); the ``formats`` (``xdmf``: results.xdmf + results.h5; ``vtu``: results.pvd +
+    frames/); ``solid`` writes the shell as a solid between its faces instead of its
+    mid-surface; probes (history.csv) and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
@@ -296,6 +303,9 @@ class Output(Section):
             raise ValueError("give either 'interval' or 'times', not both")
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
             raise ValueError(f"'times' must be strictly increasing, got {self.times}")
+        unwritten = sorted({r.field for r in self.render} - set(self.fields))
+        if unwritten:
+            raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
         names = [p.name for p in self.probe]
         duplicates = sorted({n for n in names if names.count(n) > 1})
         if duplicates:

@@ -1,4 +1,5 @@
-"""Off-screen pictures with PyVista. Works with no display: VTK renders through EGL."""
+"""Off-screen pictures with PyVista: the mesh with its named sets, and a field of a run's
+results on the deformed shape. Works with no display: VTK renders through EGL."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..element.shape import shape
+from ..errors import OutputError
 from ..mesh import Mesh
 
 #: Points drawn along each element edge so curved edges look curved.
@@ -49,6 +51,25 @@ def element_outlines(x: np.ndarray, conn: np.ndarray) -> Any:
     return pv.PolyData(curves.reshape(-1, 3), lines=lines)
 
 
+#: Camera directions (view vector, view-up) of the named views.
+VIEWS = {"top": ((0, 0, 1), (0, 1, 0)), "front": ((0, -1, 0), (0, 0, 1)), "side": ((1, 0, 0), (0, 0, 1))}
+
+
+def _look(plotter: Any, view: str, x: np.ndarray) -> None:
+    """Point the camera: a named view, isometric, or ('auto') from above a flat scene
+    (along its thinnest axis) and isometric otherwise."""
+    extent = np.ptp(x, axis=0)
+    flat_axis = int(np.argmin(extent))
+    if view == "auto" and extent[flat_axis] < 1e-9 * (float(np.linalg.norm(extent)) or 1.0):
+        plotter.view_vector(np.eye(3)[flat_axis], viewup=np.eye(3)[(flat_axis + 2) % 3])
+    elif view in VIEWS:
+        plotter.view_vector(*VIEWS[view])
+    else:
+        plotter.view_isometric()
+    plotter.reset_camera()
+    plotter.camera.zoom(0.85)
+
+
 def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> None:
     """PNG of the mesh: surface, element edges, and every edge and point set in its own
     colour with a legend. Flat meshes are seen from above, others isometrically."""
@@ -73,11 +94,124 @@ def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> 
     if legend:
         plotter.add_legend(legend, bcolor="white", face="circle", loc="upper left",
                            size=(0.22, min(0.9, 0.035 * len(legend) + 0.02)))
-    flat_axis = int(np.argmin(extent))
-    if extent[flat_axis] < 1e-9 * scale:
-        plotter.view_vector(np.eye(3)[flat_axis], viewup=np.eye(3)[(flat_axis + 2) % 3])
-    else:
-        plotter.view_isometric()
-    plotter.camera.zoom(0.85)
+    _look(plotter, "auto", mesh.x)
     plotter.screenshot(str(path))
     plotter.close()
+
+
+#: The outer ring of an element's 4 x 4 sub-cell corners (r fastest), closed.
+ELEMENT_RING = np.array([0, 1, 2, 3, 7, 11, 15, 14, 13, 12, 8, 4, 0])
+#: Columns of a 3-vector and of a row-by-row 3 x 3 tensor.
+VECTOR_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+TENSOR_COMPONENTS = {"xx": 0, "yy": 4, "zz": 8, "xy": 1, "yz": 5, "zx": 2}
+RENDERS_DIR = "renders"
+
+
+def field_values(point_data: dict, cell_data: dict, field: str, component: str | None) -> tuple[np.ndarray, bool, str]:
+    """(values, on_cells, component) of a scalar picked from a frame: a scalar field as it
+    is, a vector's component (magnitude by default), a tensor's component (xx by default)."""
+    on_cells = field in cell_data
+    if not on_cells and field not in point_data:
+        known = sorted({*point_data, *cell_data})
+        raise OutputError(f"field '{field}' is not in the results; written fields: {', '.join(known)}")
+    values = np.asarray((cell_data if on_cells else point_data)[field], dtype=float)
+    columns = values.shape[1] if values.ndim == 2 else 1
+    named = {1: {}, 3: VECTOR_COMPONENTS | {"magnitude": None}, 9: TENSOR_COMPONENTS}[columns]
+    if columns == 1:
+        if component is not None:
+            raise OutputError(f"field '{field}' is a scalar; leave out the component")
+        return values.reshape(-1), on_cells, ""
+    component = component or ("xx" if columns == 9 else "magnitude")
+    if component not in named:
+        raise OutputError(f"component '{component}' does not fit field '{field}'; expected one of {', '.join(named)}")
+    column = named[component]
+    return (np.linalg.norm(values, axis=1) if column is None else values[:, column]), on_cells, component
+
+
+def _series_units(folder: Path) -> tuple[str, str]:
+    """(title, unit system) of the deck a results folder was run from, if it is there."""
+    import tomllib
+
+    try:
+        meta = tomllib.loads((folder / "deck.toml").read_text(encoding="utf-8")).get("meta", {})
+    except (OSError, tomllib.TOMLDecodeError):
+        return "", "consistent"
+    return meta.get("title", ""), meta.get("units", "consistent")
+
+
+def _frame_indices(frame: str | int, count: int) -> list[int]:
+    if frame == "all":
+        return list(range(count))
+    if frame == "last":
+        return [count - 1]
+    index = int(frame)
+    if not -count <= index < count:
+        raise OutputError(f"frame {index} does not exist; the series has frames 0 to {count - 1}")
+    return [index % count]
+
+
+def render_field(folder: Path, field: str = "pressure_band", frame: str | int = "last", view: str = "iso",
+                 size: tuple[int, int] = (1200, 900), component: str | None = None,
+                 out_dir: Path | None = None) -> list[Path]:
+    """PNGs of ``field`` on the deformed shape for the chosen frames of the series in
+    ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
+    to ``out_dir`` (default ``folder/renders``). Returns the files written."""
+    from .fields import NODAL_SUFFIX, unit
+    from .series import StoredSeries
+
+    series = StoredSeries(folder)
+    indices = _frame_indices(frame, len(series.times))
+    frames = [series.frame(i) for i in indices]
+    picked = [field_values(p, c, field, component) for p, c in frames]
+    low = min(float(v.min()) for v, _, _ in picked)
+    high = max(float(v.max()) for v, _, _ in picked)
+    if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
+        low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
+    title, units = _series_units(folder)
+    label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
+    bar = f"{label} {picked[0][2]}".strip() + (f" ({unit(field, units)})" if unit(field, units) not in ("-", "") else "")
+    out_dir = out_dir or folder / RENDERS_DIR
+    out_dir.mkdir(parents=True, exist_ok=True)
+    stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
+    written = []
+    for index, (point_data, _), (values, on_cells, _) in zip(indices, frames, picked):
+        path = out_dir / f"{stem}_{index:04d}.png"
+        deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
+        _render_frame(deformed, series, values, on_cells, bar, (low, high), view, size,
+                      f"{title}\nt = {series.times[index]:.6g}", path)
+        written.append(path)
+    if frame == "all":
+        import imageio.v3 as iio
+
+        gif = out_dir / f"{stem}.gif"
+        iio.imwrite(gif, np.stack([iio.imread(p) for p in written]), duration=200, loop=0)
+        written.append(gif)
+    return written
+
+
+def _render_frame(points: np.ndarray, series, values: np.ndarray, on_cells: bool, bar: str,
+                  limits: tuple[float, float], view: str, size: tuple[int, int], caption: str, path: Path) -> None:
+    """One PNG: the sub-cells at ``points`` coloured by ``values``, element outlines on top."""
+    pv = _pyvista()
+    cell_type = pv.CellType.HEXAHEDRON if series.cell_type == "hexahedron" else pv.CellType.QUAD
+    grid = pv.UnstructuredGrid({cell_type: series.cells}, points)
+    if on_cells:
+        grid.cell_data["values"] = values
+    else:
+        grid.point_data["values"] = values
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    plotter.set_background("white")
+    plotter.add_mesh(grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
+                     scalar_bar_args={"title": bar, "color": "black", "vertical": False, "fmt": "%.4g",
+                                      "position_x": 0.2, "position_y": 0.04, "width": 0.6, "height": 0.07,
+                                      "title_font_size": max(10, size[1] // 40),
+                                      "label_font_size": max(8, size[1] // 50)})
+    rings = np.arange(0, len(points), 16)[:, None] + ELEMENT_RING[None]
+    lines = np.hstack([np.full((len(rings), 1), len(ELEMENT_RING)), rings]).ravel()
+    plotter.add_mesh(pv.PolyData(points, lines=lines), color="black", line_width=2)
+    plotter.add_text(caption, position="upper_left", font_size=max(6, size[1] // 90), color="black")
+    _look(plotter, view, points)
+    try:
+        plotter.screenshot(str(path))
+    finally:
+        plotter.close()

@@ -22,7 +22,9 @@ def reference_results(run: Run) -> list[dict]:
     return [check(ref, times, np.asarray(run.history[ref.probe])) for ref in run.deck.reference]
 
 
-def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None) -> dict:
+def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, output_seconds: float = 0.0) -> dict:
+    """The record of a run; ``output_seconds`` is the part of the wall time spent writing
+    histories and frames."""
     state, model = run.sim.state, run.model
     e = state.energy
     steps = max(state.steps, 1)
@@ -42,7 +44,10 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None) -
         "steps": state.steps,
         "sim_time": state.t,
         "wall_time_s": run.wall_time,
-        "us_per_element_step": 1e6 * run.wall_time / (steps * model.n_elements),
+        "output_wall_time_s": output_seconds,
+        "frames": len(run.frame_times),
+        "units": run.deck.meta.units,
+        "us_per_element_step": 1e6 * (run.wall_time - output_seconds) / (steps * model.n_elements),
         "dt": dt_statistics(run),
         "energy": {
             "internal": float(e[INTERNAL]), "kinetic": float(e[KINETIC]),

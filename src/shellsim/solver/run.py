@@ -2,7 +2,8 @@
 events that writers and the progress display listen to.
 
 The solver knows nothing about files: it calls ``listener.on_sample(run)`` at every
-history time and ``listener.on_dt(run)`` after each critical-step estimate.
+history time, ``listener.on_frame(run)`` at t = 0 and at every output time, and
+``listener.on_dt(run)`` after each critical-step estimate.
 """
 
 from __future__ import annotations
@@ -14,8 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..deck import Deck
-from ..element.sampling import global_stress, nearest_integration_point
-from ..errors import NotYetAvailable, NumericalError
+from ..element.sampling import nearest_integration_point
+from ..errors import NumericalError
 from ..mesh import Mesh
 from ..model import FACES, Model
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
@@ -27,7 +28,8 @@ HISTORY_SAMPLES = 2000
 UNSTABLE_BALANCE = 0.5
 #: Energies below this share of the external work are round-off, not a balance to judge.
 ENERGY_FLOOR = 1e-12
-NODAL_QUANTITIES = ("displacement", "position", "director", "rotation", "thickness")
+#: Quantities read at the integration point nearest to the probe's set.
+POINT_QUANTITIES = ("stress", "strain", "pressure_band")
 
 
 #: Tensor components of a probe as (row, column) of the global tensor.
@@ -63,6 +65,7 @@ class Run:
     times: list[float] = field(default_factory=list)
     history: dict[str, list[float]] = field(default_factory=dict)
     energies: list[np.ndarray] = field(default_factory=list)
+    frame_times: list[float] = field(default_factory=list)
     wall_time: float = 0.0
     status: str = "running"
 
@@ -82,6 +85,9 @@ class Listener:
     def on_sample(self, run: Run) -> None:
         pass
 
+    def on_frame(self, run: Run) -> None:
+        pass
+
 
 class Listeners(Listener):
     """Passes every event to each of several listeners, in order."""
@@ -97,14 +103,45 @@ class Listeners(Listener):
         for listener in self.listeners:
             listener.on_sample(run)
 
+    def on_frame(self, run: Run) -> None:
+        for listener in self.listeners:
+            listener.on_frame(run)
+
+
+class Timed(Listener):
+    """Passes every event to ``listener`` and adds up the wall time it takes [s]."""
+
+    def __init__(self, listener: Listener):
+        self.listener = listener
+        self.seconds = 0.0
+
+    def _timed(self, event, run: Run) -> None:
+        start = time.perf_counter()
+        try:
+            event(run)
+        finally:
+            self.seconds += time.perf_counter() - start
+
+    def on_dt(self, run: Run) -> None:
+        self._timed(self.listener.on_dt, run)
+
+    def on_sample(self, run: Run) -> None:
+        self._timed(self.listener.on_sample, run)
+
+    def on_frame(self, run: Run) -> None:
+        self._timed(self.listener.on_frame, run)
+
 
 def probe_value(run: Run, probe: Probe) -> float:
     """The probe's current value (the mean over its nodes)."""
     s, m = run.sim.state, run.model
     nodes = probe.nodes
-    if probe.quantity == "stress":
+    if probe.quantity in POINT_QUANTITIES:
         e, p = probe.element, probe.point
-        tensor = global_stress(s.x, s.d, s.h, m.conn[e], m.N[p], m.dNr[p], m.dNs[p], m.tz, m.wt, s.stress[e, p])
+        _, cauchy, green = run.sim.point_tensors(slice(e, e + 1), slice(p, p + 1))
+        tensor = np.einsum("k,kij->ij", m.wt / m.wt.sum(), (green if probe.quantity == "strain" else cauchy)[0, 0])
+        if probe.quantity == "pressure_band":
+            return float(-np.trace(tensor) / 3.0)
         return float(tensor[TENSOR_COMPONENTS[probe.component]])
     if probe.quantity == "thickness":
         return float(s.h[nodes].mean())
@@ -127,13 +164,11 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     probes = []
     for p in deck.output.probe:
         nodes = mesh.sets[p.set].nodes
-        if p.quantity == "stress":
+        if p.quantity in POINT_QUANTITIES:
             element, point = nearest_integration_point(model.x0, model.conn, model.N[:len(model.wq)],
                                                        model.x0[nodes].mean(axis=0))
             probes.append(Probe(p.name, p.quantity, p.component, nodes, element, point))
             continue
-        if p.quantity not in NODAL_QUANTITIES:
-            raise NotYetAvailable(f"output.probe '{p.name}': {p.quantity} probes are not available yet")
         probes.append(Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face]))
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
@@ -161,6 +196,11 @@ def _record(run: Run, listener: Listener) -> None:
         run.history[p.name].append(probe_value(run, p))
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
+
+
+def _frame(run: Run, listener: Listener) -> None:
+    listener.on_frame(run)
+    run.frame_times.append(run.sim.state.t)
 
 
 def _update_time_step(run: Run, listener: Listener) -> None:
@@ -209,6 +249,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     try:
         _update_time_step(run, listener)
         _record(run, listener)
+        _frame(run, listener)
         since_update = 0
         history_interval = solver.end_time / HISTORY_SAMPLES
         for landing in output_times(run.deck):
@@ -231,6 +272,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                         break  # re-plan the steps with the new dt
                 _record(run, listener)
                 _check_stability(run)
+            _frame(run, listener)
         run.status = "completed"
     except NumericalError:
         run.status = "unstable"

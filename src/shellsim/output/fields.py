@@ -1,0 +1,164 @@
+"""What an output frame holds: the viewing mesh and the field arrays on it.
+
+Each element is cut into one sub-cell per integration point (3 x 3 in the plane; with
+``solid``, times the layers through the thickness), the cuts laid at the Gauss weights'
+boundaries (-1, -4/9, 4/9, 1), so each sub-cell holds its own point's value and stress
+jumps between and inside elements stay visible, as in the thesis' pressure-band figures.
+Sub-cell corners are not shared between elements. The shell view sits on the
+mid-surface with thickness-mean values (von Mises: the largest over the layers), and point fields ``<name>_nodal`` beside the cell
+fields carry a smoothed version (Gauss values extrapolated to the element's nodes, averaged
+over the elements sharing a node). The solid view places the corners on the layer
+boundaries (top, bottom and between) from directors and fibre lengths.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..element.shape import gauss_rule, shape
+from ..model import Model
+from ..solver.simulation import Simulation
+
+POINT_FIELDS = ("displacement", "director", "thickness")
+CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
+NODAL_SUFFIX = "_nodal"
+#: Fields the shell view shows as their largest value through the thickness (a bent
+#: shell's equivalent stress peaks at its faces); the others as the thickness mean.
+LARGEST_THROUGH_THICKNESS = ("von_mises",)
+
+#: What each field or probe quantity measures, for units in titles and axis labels.
+FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
+              "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
+              "von_mises": "stress", "time": "time"}
+#: Units of each kind per deck unit system (meta.units); nothing is converted.
+UNITS = {"SI": {"length": "m", "stress": "Pa", "time": "s"},
+         "mm-t-s": {"length": "mm", "stress": "MPa", "time": "s"},
+         "mm-kg-ms": {"length": "mm", "stress": "GPa", "time": "ms"},
+         "in-lbf-s": {"length": "in", "stress": "psi", "time": "s"},
+         "consistent": {}}
+
+#: Sub-cell boundaries along r or s: the 3-point Gauss weights laid end to end.
+SUB_BOUNDS = -1.0 + np.concatenate([[0.0], np.cumsum(gauss_rule(3)[1])])
+#: Natural coordinates of the 4 x 4 sub-cell corners, r fastest. Shape (16, 2).
+CORNER_RS = np.array([(r, s) for s in SUB_BOUNDS for r in SUB_BOUNDS])
+#: Corners of the sub-cell of in-plane point q = i_r + 3 i_s (counter-clockwise). Shape (9, 4).
+SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in range(3) for i in range(3))])
+
+
+def unit(field: str, system: str) -> str:
+    """The unit of ``field`` (a field or probe quantity, possibly with the nodal suffix, or
+    a kind: length, stress, time) in ``system``; '-' when it has none."""
+    name = field.removesuffix(NODAL_SUFFIX)
+    kind = FIELD_KIND.get(name, name if name in ("length", "stress", "time") else None)
+    return UNITS.get(system, {}).get(kind, "") if kind else "-"
+
+
+@dataclass(frozen=True)
+class OutputMesh:
+    """The viewing mesh of a model.
+
+    points (P, 3): initial positions, P = ne * L * 16; cells (C, 4) quads (shell) or (C, 8)
+    hexahedra (solid), C = ne * 9 * nt for the solid, ne * 9 for the shell; layers (L,):
+    thickness coordinates of the corner layers ([0] for the shell).
+    """
+
+    points: np.ndarray
+    cells: np.ndarray
+    cell_type: str
+    layers: np.ndarray
+
+    @property
+    def solid(self) -> bool:
+        return self.cell_type == "hexahedron"
+
+
+def _at_corners(nodal: np.ndarray, conn: np.ndarray, layers: int) -> np.ndarray:
+    """Nodal values (n, ...) interpolated to the sub-cell corners of each element and
+    repeated on each of ``layers`` corner layers: (ne * layers * 16, ...)."""
+    values = np.einsum("ca,ea...->ec...", shape(CORNER_RS), nodal[conn])
+    return np.repeat(values[:, None], layers, axis=1).reshape(-1, *nodal.shape[1:])
+
+
+def _corner_points(x: np.ndarray, d: np.ndarray, h: np.ndarray, conn: np.ndarray, layers: np.ndarray) -> np.ndarray:
+    """Positions (ne * L * 16, 3) of the sub-cell corners on each layer t of ``layers``
+    (L,): mid-surface plus t times half the fibre."""
+    t = np.tile(np.repeat(layers, 16), len(conn))[:, None]
+    return _at_corners(x, conn, len(layers)) + t * _at_corners(0.5 * h[:, None] * d, conn, len(layers))
+
+
+def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
+    """The shell view (mid-surface quads) or the solid view (hexahedra through the
+    thickness) of ``model``."""
+    ne = model.n_elements
+    if solid:
+        layers = -1.0 + np.concatenate([[0.0], np.cumsum(model.wt)])
+        bottom = (np.arange(len(model.wt))[:, None, None] * 16 + SUB_QUADS[None]).reshape(-1, 4)
+        local = np.hstack([bottom, bottom + 16])
+    else:
+        layers = np.zeros(1)
+        local = SUB_QUADS
+    cells = (np.arange(ne)[:, None, None] * len(layers) * 16 + local[None]).reshape(-1, local.shape[1])
+    points = _corner_points(model.x0, model.d0, model.h0, model.conn, layers)
+    return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers)
+
+
+def von_mises(sigma: np.ndarray) -> np.ndarray:
+    """sqrt(3/2 s:s), s the deviator of each (..., 3, 3) stress."""
+    deviator = sigma - np.trace(sigma, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3.0
+    return np.sqrt(1.5 * np.einsum("...ij,...ij->...", deviator, deviator))
+
+
+def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
+    """Each requested cell field at every integration point, (ne, nq, nt, ...)."""
+    lamina, cauchy, green = sim.point_tensors()
+    values = {"cauchy_stress": cauchy, "lamina_stress": lamina, "green_lagrange_strain": green,
+              "pressure_band": -np.trace(cauchy, axis1=-2, axis2=-1) / 3.0}
+    if "von_mises" in fields:
+        values["von_mises"] = von_mises(cauchy)
+    return {name: values[name] for name in fields if name in CELL_FIELDS}
+
+
+def _smoothed(model: Model, cell_values: np.ndarray) -> np.ndarray:
+    """Nodal version (ne * 16, ...) at the shell view's corners of per-point values
+    (ne, 9, ...): the biquadratic through an element's 3 x 3 Gauss values, read at its
+    nodes, averaged over the elements sharing each node, interpolated back to the corners."""
+    extrapolate = np.linalg.inv(model.N[:len(model.wq)])  # Gauss values -> node values
+    at_nodes = np.einsum("aq,eq...->ea...", extrapolate, cell_values)
+    total = np.zeros((model.n_nodes, *cell_values.shape[2:]))
+    np.add.at(total, model.conn, at_nodes)
+    count = np.bincount(model.conn.ravel(), minlength=model.n_nodes)
+    return _at_corners(total / count.reshape(-1, *([1] * (total.ndim - 1))), model.conn, 1)
+
+
+def _columns(values: np.ndarray) -> np.ndarray:
+    """(m, 1) -> (m,): scalars are written as 1D arrays."""
+    return values[:, 0] if values.shape[1] == 1 else values
+
+
+def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[dict, dict]:
+    """(point_data, cell_data) of the current state for the requested ``fields``: arrays
+    of shape (P,) or (P, 3) on the points, (C,) or (C, 9) on the cells; tensors are written
+    row by row (xx, xy, xz, yx, ...), as ParaView reads a 9-component array."""
+    model, state = sim.model, sim.state
+    points = _corner_points(state.x, state.d, state.h, model.conn, mesh.layers)
+    point_data: dict[str, np.ndarray] = {}
+    if "displacement" in fields:
+        point_data["displacement"] = points - mesh.points
+    if "director" in fields:
+        director = _at_corners(state.d, model.conn, len(mesh.layers))
+        point_data["director"] = director / np.linalg.norm(director, axis=1, keepdims=True)
+    if "thickness" in fields:
+        point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
+    cell_data: dict[str, np.ndarray] = {}
+    weights = model.wt / model.wt.sum()
+    for name, values in _point_values(sim, fields).items():
+        flat = values.reshape(*values.shape[:3], -1)  # (ne, nq, nt, 1 or 9)
+        if mesh.solid:
+            cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
+        else:
+            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else np.einsum("k,eqkc->eqc", weights, flat)
+            cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
+            point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, through))
+    return point_data, cell_data

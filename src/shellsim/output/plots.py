@@ -1,0 +1,135 @@
+"""Line plots of a finished run (matplotlib, no display needed): each probe's history
+against time, and against the load when one load follows a time curve (load-displacement
+curves such as the thesis' Figures 4.29 and 4.33), with the deck's references drawn on
+them; and the energies."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..deck import parse_deck
+from ..errors import OutputError
+from .fields import unit
+
+PLOTS_DIR = "plots"
+#: How each reference measure is drawn: as points on the curve, or as a level.
+POINT_MEASURES = ("at_time", "final")
+LEVEL_MEASURES = ("max", "min", "max_abs")
+
+
+def _read(folder: Path) -> tuple[object, np.ndarray]:
+    """(resolved deck, history table with named columns) of a results folder."""
+    try:
+        deck = parse_deck((folder / "deck.toml").read_text(encoding="utf-8"), name=str(folder / "deck.toml"))
+        history = np.genfromtxt(folder / "history.csv", delimiter=",", names=True, ndmin=1)
+    except OSError as error:
+        raise OutputError(f"'{folder}' is not a finished run's folder: {error.strerror or error} "
+                          f"({error.filename})") from None
+    if history.size == 0 or history.dtype.names is None:
+        raise OutputError(f"'{folder / 'history.csv'}' has no samples yet")
+    return deck, history
+
+
+def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
+    """(value of the first time-curved load at ``times``, axis label), or None."""
+    for load in deck.load:
+        if getattr(load, "curve", None) and np.ndim(load.value) == 0:
+            kind = "stress" if load.type in ("pressure", "edge_pressure") else "load"
+            label = f"{load.type.replace('_', ' ')} on '{load.set}'"
+            return load.value * deck.curves[load.curve](times), _labelled(label, unit(kind, deck.meta.units))
+    return None
+
+
+def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
+    """PNGs of every probe's history (``<probe>.png``) and of the energies
+    (``energy.png``) in ``out_dir`` (default ``folder/plots``). Returns the files written."""
+    from matplotlib.figure import Figure
+
+    deck, history = _read(folder)
+    out_dir = out_dir or folder / PLOTS_DIR
+    out_dir.mkdir(parents=True, exist_ok=True)
+    times = history["time"]
+    load = _load_axis(deck, times)
+    written = []
+    for probe in deck.output.probe:
+        values = history[probe.name]
+        figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")
+        axes = figure.subplots(1, 2 if load else 1, squeeze=False)[0]
+        units = unit(probe.quantity, deck.meta.units)
+        ylabel = _labelled(probe.name, units)
+        for ax, x, xlabel in zip(axes, (times, *(load[:1] if load else ())),
+                                 (_labelled("time", unit("time", deck.meta.units)), *(load[1:] if load else ()))):
+            ax.plot(x, values, color="black", lw=1.4, label="shellsim")
+            _draw_references(ax, deck, probe.name, times, x)
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(ylabel)
+            ax.grid(alpha=0.3)
+        axes[0].legend(fontsize="small", loc="best")
+        figure.suptitle(deck.meta.title, fontsize="medium")
+        written.append(_save(figure, out_dir / f"{probe.name}.png"))
+    written.append(_plot_energy(deck, history, out_dir / "energy.png", size))
+    return written
+
+
+def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray) -> None:
+    """The deck's references on ``probe`` over the axis ``x`` (a function of ``times``)."""
+    colours = iter(["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"])
+    for measure in dict.fromkeys(r.measure for r in deck.reference if r.probe == probe):
+        refs = [r for r in deck.reference if r.probe == probe and r.measure == measure]
+        colour = next(colours, "grey")
+        label = f"reference ({measure.replace('_', ' ')}): {refs[0].source}"
+        if measure in POINT_MEASURES:
+            at = [times[-1] if r.measure == "final" else r.time for r in refs]
+            ax.errorbar(np.interp(at, times, x), [r.expected for r in refs], fmt="o", color=colour, ms=5,
+                        yerr=[_tolerance(r) for r in refs], capsize=3, label=_short(label))
+        elif measure in LEVEL_MEASURES:
+            for r in refs:
+                for level in ((r.expected, -r.expected) if measure == "max_abs" else (r.expected,)):
+                    ax.axhline(level, color=colour, ls="--", lw=1, label=_short(label))
+        elif measure == "first_peak_time" and x is times:
+            for r in refs:
+                ax.axvline(r.expected, color=colour, ls="--", lw=1, label=_short(label))
+
+
+def _labelled(name: str, units: str) -> str:
+    return name + (f" ({units})" if units not in ("-", "") else "")
+
+
+def _tolerance(reference) -> float:
+    """The reference's tolerance band half-width, in the quantity's units."""
+    if reference.tolerance is not None:
+        return reference.tolerance
+    return abs(reference.expected) * reference.tolerance_percent / 100.0
+
+
+def _short(text: str, limit: int = 70) -> str:
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float]) -> Path:
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=size, layout="constrained")
+    ax = figure.subplots()
+    t = history["time"]
+    for column, label in (("internal_energy", "internal"), ("kinetic_energy", "kinetic"),
+                          ("external_work", "external work"), ("damping_work", "damping work")):
+        ax.plot(t, history[column], label=label)
+    balance = history["internal_energy"] + history["kinetic_energy"] + history["damping_work"] - history["external_work"]
+    ax.plot(t, balance, color="black", ls=":", label="balance (internal + kinetic + damping - external)")
+    ax.set_xlabel("time")
+    ax.set_ylabel("energy")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize="small")
+    figure.suptitle(deck.meta.title, fontsize="medium")
+    return _save(figure, path)
+
+
+def _save(figure, path: Path) -> Path:
+    try:
+        figure.savefig(path, dpi=110)
+    except OSError as error:
+        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+    return path

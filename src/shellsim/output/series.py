@@ -1,0 +1,169 @@
+"""Time series of output frames: ``results.xdmf`` + ``results.h5``, and ``results.pvd`` +
+``frames/*.vtu``, each left readable after every frame, so a run that stops (Ctrl-C, a
+numerical failure, a killed process) keeps every frame written so far.
+
+The XDMF series is meshio's own ``TimeSeriesWriter`` layout (``meshio.xdmf.TimeSeriesReader``
+and ParaView read it) with two changes: the ``.h5`` is created beside the ``.xdmf``, not in
+the working directory, and the XML is rewritten atomically after every frame instead of
+only on close.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+import numpy as np
+
+from ..deck.schema import Output
+from ..errors import OutputError
+from ..solver.run import Listener, Run
+from .fields import OutputMesh, frame_fields, output_mesh
+
+XDMF_NAME, PVD_NAME, FRAMES_DIR = "results.xdmf", "results.pvd", "frames"
+
+
+def _replace_atomically(path: Path, write) -> None:
+    """Call ``write(partial_path)`` and move the result over ``path``."""
+    partial = path.with_name(path.name + ".partial")
+    write(partial)
+    os.replace(partial, path)
+
+
+class XdmfSeries:
+    """``results.xdmf`` + ``results.h5`` in ``folder``, on ``mesh``."""
+
+    def __init__(self, folder: Path, mesh: OutputMesh):
+        import h5py
+        from meshio.xdmf import TimeSeriesWriter
+
+        self.path = folder / XDMF_NAME
+        self._writer = TimeSeriesWriter(self.path)
+        self._writer.h5_filename = str(self.path.with_suffix(".h5"))  # referenced by its base name
+        self._writer.h5_file = h5py.File(self._writer.h5_filename, "w")
+        self._writer.write_points_cells(mesh.points, {mesh.cell_type: mesh.cells})
+
+    def write(self, t: float, point_data: dict, cell_data: dict) -> None:
+        self._writer.write_data(t, point_data, {name: [values] for name, values in cell_data.items()})
+        self._writer.h5_file.flush()
+        _replace_atomically(self.path, lambda p: ET.ElementTree(self._writer.xdmf_file).write(p))
+
+    def close(self) -> None:
+        self._writer.h5_file.close()
+
+
+class VtuSeries:
+    """``results.pvd`` indexing one ``frames/results_NNNN.vtu`` per frame, in ``folder``."""
+
+    def __init__(self, folder: Path, mesh: OutputMesh):
+        self.path = folder / PVD_NAME
+        self.frames = folder / FRAMES_DIR
+        if self.frames.exists():  # frames of an earlier run would be listed by nobody
+            shutil.rmtree(self.frames)
+        self.frames.mkdir()
+        self.mesh = mesh
+        self.entries: list[tuple[float, str]] = []
+
+    def write(self, t: float, point_data: dict, cell_data: dict) -> None:
+        import meshio
+
+        name = f"{FRAMES_DIR}/results_{len(self.entries):04d}.vtu"
+        meshio.write(self.path.parent / name, meshio.Mesh(
+            self.mesh.points, [(self.mesh.cell_type, self.mesh.cells)], point_data=point_data,
+            cell_data={key: [values] for key, values in cell_data.items()}), file_format="vtu")
+        self.entries.append((t, name))
+        root = ET.Element("VTKFile", type="Collection", version="0.1")
+        collection = ET.SubElement(root, "Collection")
+        for time, file in self.entries:
+            ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
+        _replace_atomically(self.path, lambda p: ET.ElementTree(root).write(p, xml_declaration=True))
+
+    def close(self) -> None:
+        pass
+
+
+SERIES = {"xdmf": XdmfSeries, "vtu": VtuSeries}
+
+
+class FrameWriter(Listener):
+    """Writes every frame of a run to each format the deck's ``[output]`` asks for."""
+
+    def __init__(self, folder: Path, run: Run, output: Output):
+        self.fields = list(output.fields)
+        self.mesh = output_mesh(run.model, output.solid)
+        self.run = run
+        self.series = []
+        try:
+            for kind in dict.fromkeys(output.formats):
+                self.series.append(SERIES[kind](folder, self.mesh))
+        except OSError as error:
+            self.close()
+            raise OutputError(f"cannot write the {kind} series in '{folder}': {error.strerror or error}") from None
+
+    def frame_bytes(self) -> int:
+        """Bytes one frame of the current state takes in every format (data only)."""
+        point_data, cell_data = frame_fields(self.run.sim, self.mesh, self.fields)
+        return len(self.series) * sum(a.nbytes for a in (*point_data.values(), *cell_data.values()))
+
+    def on_frame(self, run: Run) -> None:
+        point_data, cell_data = frame_fields(run.sim, self.mesh, self.fields)
+        t = run.sim.state.t
+        for series in self.series:
+            try:
+                series.write(t, point_data, cell_data)
+            except OSError as error:
+                raise OutputError(f"writing the frame at t = {t:.6g} to {series.path} failed: "
+                                  f"{error.strerror or error}") from None
+
+    def close(self) -> None:
+        for series in self.series:
+            series.close()
+
+
+def check_space(folder: Path, needed: int) -> None:
+    """Raise OutputError when ``folder``'s disk has less than ``needed`` bytes free."""
+    free = shutil.disk_usage(folder).free
+    if needed > free:
+        raise OutputError(f"the run's frames need about {needed / 1e6:,.0f} MB but '{folder}' has "
+                          f"{free / 1e6:,.0f} MB free; write fewer frames (output.interval) or fields "
+                          "(output.fields), or choose another --out")
+
+
+class StoredSeries:
+    """A written series read back: ``points`` (P, 3), ``cells`` (C, k) of ``cell_type``,
+    ``times`` of the frames; :meth:`frame` gives one frame's (point_data, cell_data)."""
+
+    def __init__(self, folder: Path):
+        import meshio
+
+        self.folder = folder
+        if (folder / XDMF_NAME).exists():
+            self._reader = meshio.xdmf.TimeSeriesReader(folder / XDMF_NAME)
+            points, cells = self._reader.read_points_cells()
+            self.times = [self._reader.read_data(k)[0] for k in range(self._reader.num_steps)]
+        elif (folder / PVD_NAME).exists():
+            self._reader = None
+            index = ET.parse(folder / PVD_NAME).getroot().iter("DataSet")
+            self._files = [(float(item.get("timestep")), item.get("file")) for item in index]
+            self.times = [t for t, _ in self._files]
+            first = meshio.read(folder / self._files[0][1]) if self._files else None
+            points, cells = (first.points, first.cells) if first else (np.zeros((0, 3)), [])
+        else:
+            raise OutputError(f"'{folder}' holds no results series ({XDMF_NAME} or {PVD_NAME}); "
+                              "run a deck with --out pointing there first")
+        if not self.times:
+            raise OutputError(f"the series in '{folder}' has no frames yet")
+        self.points, self.cell_type, self.cells = points, cells[0].type, cells[0].data
+
+    def frame(self, index: int) -> tuple[dict, dict]:
+        """(point_data, cell_data) of frame ``index``, cell arrays for the one cell block."""
+        import meshio
+
+        if self._reader is not None:
+            _, point_data, cell_data = self._reader.read_data(index)
+        else:
+            stored = meshio.read(self.folder / self._files[index][1])
+            point_data, cell_data = stored.point_data, stored.cell_data
+        return dict(point_data), {name: blocks[0] for name, blocks in cell_data.items()}

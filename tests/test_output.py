@@ -1,0 +1,319 @@
+"""What a run leaves behind: the XDMF and VTU series read back with meshio and pyvista
+(times, shapes, the pressure band against the stored stresses), the sub-cell fields
+against a closed-form strain field, the resolved deck, renders and plots of Test 9, and
+the files of runs stopped by Ctrl-C or by an instability."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.deck import load_deck, parse_deck
+from shellsim.errors import OutputError
+from shellsim.geometry import build_mesh
+from shellsim.model import build_model
+from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
+from shellsim.output.series import check_space
+from shellsim.solver.run import output_times, prepare
+
+from .conftest import ROOT, deck_text
+
+runner = CliRunner()
+ALL_FIELDS = ["displacement", "director", "thickness", "cauchy_stress", "lamina_stress", "pressure_band",
+              "green_lagrange_strain", "von_mises"]
+PLATE = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', f"""
+[[boundary]]
+type = "clamped"
+set = "x0"
+
+[[load]]
+type = "pressure"
+value = 0.01
+set = "all"
+curve = "ramp"
+
+[curves.ramp]
+t = [0.0, 0.5]
+value = [0.0, 1.0]
+
+[output]
+times = [0.1, 0.25]
+formats = ["xdmf", "vtu"]
+fields = {ALL_FIELDS}
+
+[[output.probe]]
+name = "tip"
+quantity = "displacement"
+set = "x1y0"
+component = "z"
+""").replace("thickness = 0.01", "thickness = 0.05").replace("end_time = 1.0", "end_time = 0.5")
+
+
+@pytest.fixture(scope="module")
+def plate_run(tmp_path_factory):
+    """A clamped plate under a ramped pressure, written as XDMF and VTU at t = 0.1, 0.25
+    and the end (0.5)."""
+    folder = tmp_path_factory.mktemp("plate")
+    (folder / "plate.toml").write_text(PLATE)
+    result = runner.invoke(app, ["run", str(folder / "plate.toml"), "--out", str(folder / "out"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    return folder / "out"
+
+
+def test_xdmf_series_has_one_time_per_frame_and_the_sub_cell_mesh(plate_run):
+    reader = meshio.xdmf.TimeSeriesReader(plate_run / "results.xdmf")
+    points, cells = reader.read_points_cells()
+    frames = [reader.read_data(k) for k in range(reader.num_steps)]
+    assert [t for t, _, _ in frames] == pytest.approx([0.0, 0.1, 0.25, 0.5], abs=1e-12)
+    ne = 4  # 2 x 2 elements
+    assert points.shape == (ne * 16, 3) and cells[0].type == "quad" and cells[0].data.shape == (ne * 9, 4)
+    _, point_data, cell_data = frames[-1]
+    assert point_data["displacement"].shape == (ne * 16, 3)
+    assert point_data["director"].shape == (ne * 16, 3) and point_data["thickness"].shape == (ne * 16,)
+    for name in ("cauchy_stress", "lamina_stress", "green_lagrange_strain"):
+        assert cell_data[name][0].shape == (ne * 9, 9) and point_data[name + "_nodal"].shape == (ne * 16, 9)
+    assert cell_data["pressure_band"][0].shape == (ne * 9,)
+    sigma = cell_data["cauchy_stress"][0].reshape(-1, 3, 3)
+    np.testing.assert_allclose(cell_data["pressure_band"][0], -np.trace(sigma, axis1=1, axis2=2) / 3, rtol=1e-12)
+    # bending: the tip has moved, and the frame at t = 0 is the undeformed plate
+    assert abs(point_data["displacement"][:, 2]).max() > 1e-3
+    assert np.abs(frames[0][1]["displacement"]).max() == 0.0
+    # the last frame's tip deflection is the history's last probe reading
+    history = np.genfromtxt(plate_run / "history.csv", delimiter=",", names=True)
+    tip = np.argmin(np.linalg.norm(points - [2.0, 0.0, 0.0], axis=1))
+    assert point_data["displacement"][tip, 2] == pytest.approx(history["tip"][-1], rel=1e-9)
+
+
+def test_vtu_frames_hold_the_same_arrays_as_the_xdmf_series(plate_run):
+    import pyvista
+
+    index = ET.parse(plate_run / "results.pvd").getroot().iter("DataSet")
+    entries = [(float(e.get("timestep")), e.get("file")) for e in index]
+    assert [t for t, _ in entries] == pytest.approx([0.0, 0.1, 0.25, 0.5], abs=1e-12)
+    grid = pyvista.read(plate_run / entries[-1][1])
+    reader = meshio.xdmf.TimeSeriesReader(plate_run / "results.xdmf")
+    reader.read_points_cells()  # the reader needs the mesh before any frame
+    _, point_data, cell_data = reader.read_data(3)
+    np.testing.assert_array_equal(grid.point_data["displacement"], point_data["displacement"])
+    np.testing.assert_array_equal(grid.cell_data["cauchy_stress"], cell_data["cauchy_stress"][0])
+    np.testing.assert_array_equal(grid.cell_data["pressure_band"], cell_data["pressure_band"][0])
+
+
+def test_resolved_deck_loads_back_to_the_same_scene_with_the_version(plate_run):
+    from shellsim import __version__
+
+    text = (plate_run / "deck.toml").read_text()
+    assert f"shellsim {__version__}" in text.splitlines()[0]
+    original = parse_deck(PLATE)
+    assert parse_deck(text) == original
+    assert "dt_safety_factor" in text and "points_through_thickness" in text  # defaults written out
+
+
+def test_summary_records_frames_and_output_time(plate_run):
+    summary = json.loads((plate_run / "summary.json").read_text())
+    assert summary["frames"] == 4
+    assert 0.0 < summary["output_wall_time_s"] < summary["wall_time_s"]
+
+
+def _plate_simulation(displacement, director=None):
+    """A 2 x 2 flat plate with its mid-surface moved by ``displacement(x0)`` (n, 3) and
+    its directors set to ``director(x0)`` (n, 3) if given."""
+    deck = parse_deck(PLATE)
+    mesh = build_mesh(deck)
+    run = prepare(deck, mesh, build_model(deck, mesh))
+    run.sim.state.x[:] = run.model.x0 + displacement(run.model.x0)
+    if director is not None:
+        d = director(run.model.x0)
+        run.sim.state.d[:] = d / np.linalg.norm(d, axis=1, keepdims=True)
+    return run
+
+
+def test_sub_cells_carry_their_gauss_points_values_and_the_nodal_version_is_exact_for_quadratics():
+    """u_x = a x^2 gives E_xx = 2 a x + 2 a^2 x^2 (quadratic in x), exactly represented by
+    the 9-node element on a regular mesh: every sub-cell holds the value at the Gauss point
+    inside it, and the smoothed nodal version equals the closed form at every corner."""
+    a = 0.05
+    run = _plate_simulation(lambda x0: np.column_stack([a * x0[:, 0] ** 2, 0 * x0[:, 0], 0 * x0[:, 0]]))
+    mesh = output_mesh(run.model)
+    point_data, cell_data = frame_fields(run.sim, mesh, ["green_lagrange_strain"])
+    exx = lambda x: 2 * a * x + 2 * a ** 2 * x ** 2  # noqa: E731
+    corners = mesh.points[mesh.cells]  # (C, 4, 3)
+    gauss_x = np.einsum("qa,ea->eq", run.model.N[:9], run.model.x0[run.model.conn][:, :, 0]).reshape(-1)
+    inside = (corners[:, :, 0].min(axis=1) < gauss_x) & (gauss_x < corners[:, :, 0].max(axis=1))
+    assert inside.all()
+    np.testing.assert_allclose(cell_data["green_lagrange_strain"][:, 0], exx(gauss_x), rtol=1e-10)
+    np.testing.assert_allclose(point_data["green_lagrange_strain_nodal"][:, 0], exx(mesh.points[:, 0]), rtol=1e-9, atol=1e-11 * exx(2.0))
+    assert np.abs(cell_data["green_lagrange_strain"][:, [4, 8]]).max() < 1e-14  # nothing along y or z
+
+
+def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_view():
+    """Plate bent to w = 0.001 x^2, directors normal to it: each solid sub-cell's von Mises is sqrt(3/2 s:s) of its own Cauchy
+    stress; the shell view shows the largest over the layers (the faces), its Cauchy stress
+    the thickness mean."""
+    zero = lambda x0: 0 * x0[:, 0]  # noqa: E731
+    run = _plate_simulation(lambda x0: np.column_stack([zero(x0), zero(x0), 0.001 * x0[:, 0] ** 2]),
+                            lambda x0: np.column_stack([-0.002 * x0[:, 0], zero(x0), 1 + zero(x0)]))
+    run.sim.evaluate_forces()
+    nt = len(run.model.tz)
+    _, solid = frame_fields(run.sim, output_mesh(run.model, solid=True), ["cauchy_stress", "von_mises"])
+    _, shell = frame_fields(run.sim, output_mesh(run.model), ["cauchy_stress", "von_mises"])
+    sigma = solid["cauchy_stress"].reshape(-1, 3, 3)
+    deviator = sigma - np.trace(sigma, axis1=1, axis2=2)[:, None, None] * np.eye(3) / 3
+    np.testing.assert_allclose(solid["von_mises"], np.sqrt(1.5 * (deviator ** 2).sum(axis=(1, 2))), rtol=1e-12)
+    by_layer = solid["von_mises"].reshape(run.model.n_elements, nt, 9)
+    np.testing.assert_array_equal(shell["von_mises"], by_layer.max(axis=1).ravel())
+    weights = run.model.wt / run.model.wt.sum()
+    mean = np.einsum("k,ekqc->eqc", weights, solid["cauchy_stress"].reshape(run.model.n_elements, nt, 9, 9))
+    np.testing.assert_allclose(shell["cauchy_stress"], mean.reshape(-1, 9), rtol=1e-12, atol=1e-15)
+    assert (by_layer.max(axis=1) > 1.2 * by_layer.min(axis=1)).any()  # the faces differ: the choice matters
+
+
+def test_solid_view_puts_the_faces_half_a_fibre_from_the_mid_surface():
+    run = _plate_simulation(lambda x0: np.zeros_like(x0))
+    solid = output_mesh(run.model, solid=True)
+    nt = len(run.model.tz)
+    assert solid.cells.shape == (run.model.n_elements * 9 * nt, 8)
+    assert solid.points.shape == (run.model.n_elements * (nt + 1) * 16, 3)
+    z = solid.points[:, 2].reshape(run.model.n_elements, nt + 1, 16)
+    np.testing.assert_allclose(z[:, 0], -0.025)
+    np.testing.assert_allclose(z[:, -1], 0.025)
+    assert len(SUB_BOUNDS) == 4 and CORNER_RS.shape == (16, 2)
+    volumes = [box_volume(solid.points[c]) for c in solid.cells]
+    assert sum(volumes) == pytest.approx(2.0 * 1.0 * 0.05, rel=1e-12)
+
+
+def box_volume(corners: np.ndarray) -> float:
+    """Volume of an axis-aligned box given by its 8 corners (8, 3)."""
+    return float(np.prod(np.ptp(corners, axis=0)))
+
+
+def test_not_enough_disk_space_is_reported_before_the_run(tmp_path):
+    with pytest.raises(OutputError, match="MB free"):
+        check_space(tmp_path, 10 ** 18)
+
+
+# --- Test 9: renders and plots of a finished run ---------------------------------------
+
+TEST9 = ROOT / "decks" / "verification" / "test09_aorta_slow_M2.toml"
+
+
+@pytest.fixture(scope="module")
+def test9_run(tmp_path_factory):
+    """Test 9 through the command line: exit code 0 means every reference passed."""
+    folder = tmp_path_factory.mktemp("test9")
+    result = runner.invoke(app, ["run", str(TEST9), "--out", str(folder), "--quiet"])
+    assert result.exit_code == 0, result.output
+    return folder
+
+
+def test_test9_series_has_a_frame_at_each_output_time(test9_run):
+    reader = meshio.xdmf.TimeSeriesReader(test9_run / "results.xdmf")
+    reader.read_points_cells()
+    times = [reader.read_data(k)[0] for k in range(reader.num_steps)]
+    assert times == pytest.approx([0.0, *output_times(load_deck(TEST9))], abs=1e-12)
+
+
+def _picture_contrast(path: Path) -> tuple[tuple[int, int], float]:
+    import imageio.v3 as iio
+
+    image = iio.imread(path)[..., :3].astype(float)
+    return (image.shape[1], image.shape[0]), float(image.std())
+
+
+def test_render_of_test9_writes_a_picture_of_the_requested_size_that_is_not_blank(test9_run):
+    result = runner.invoke(app, ["render", str(test9_run), "--size", "640x480", "--view", "iso"])
+    assert result.exit_code == 0, result.output
+    (png,) = (test9_run / "renders").glob("pressure_band_iso_*.png")
+    size, contrast = _picture_contrast(png)
+    assert size == (640, 480)
+    assert contrast > 20.0  # a white background alone has none
+
+
+def test_render_of_every_frame_also_makes_an_animated_gif(test9_run, tmp_path):
+    import imageio.v3 as iio
+
+    result = runner.invoke(app, ["render", str(test9_run), "--frame", "all", "--field", "von_mises_nodal",
+                                 "--size", "320x240", "--out", str(tmp_path)])
+    assert result.exit_code == 2 and "von_mises_nodal" in result.output  # not written by this deck
+    result = runner.invoke(app, ["render", str(test9_run), "--frame", "all", "--field", "displacement",
+                                 "--component", "x", "--size", "320x240", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    frames = len(list(tmp_path.glob("displacement_x_iso_*.png")))
+    assert frames == len(output_times(load_deck(TEST9))) + 1
+    assert iio.imread(tmp_path / "displacement_x_iso.gif").shape[0] == frames
+
+
+def test_deck_renders_are_written_at_the_end_of_the_run(test9_run):
+    assert (test9_run / "renders").is_dir()
+    requested = load_deck(TEST9).output.render
+    assert requested and all(list((test9_run / "renders").glob(f"{r.field}_{r.view}_*.png")) for r in requested)
+
+
+def test_plot_draws_each_probe_with_its_references_and_the_energies(test9_run):
+    result = runner.invoke(app, ["plot", str(test9_run)])
+    assert result.exit_code == 0, result.output
+    deck = load_deck(TEST9)
+    for name in [p.name for p in deck.output.probe] + ["energy"]:
+        size, contrast = _picture_contrast(test9_run / "plots" / f"{name}.png")
+        assert contrast > 10.0
+
+
+# --- runs that stop early ---------------------------------------------------------------
+
+def _wait_for_frames(path: Path, count: int, process: subprocess.Popen, limit: float = 600.0) -> None:
+    start = time.monotonic()
+    while time.monotonic() - start < limit:
+        assert process.poll() is None, process.communicate()
+        if path.exists():
+            try:
+                if meshio.xdmf.TimeSeriesReader(path).num_steps >= count:
+                    return
+            except Exception:  # noqa: BLE001 - the file is replaced atomically; retry until it has frames
+                pass
+        time.sleep(0.2)
+    raise AssertionError(f"no {count} frames in {path} after {limit} s")
+
+
+def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path):
+    deck = tmp_path / "long.toml"
+    deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 500.0")
+                    .replace("times = [0.1, 0.25]", "interval = 0.5"))
+    out = tmp_path / "out"
+    process = subprocess.Popen([sys.executable, "-m", "shellsim", "run", str(deck), "--out", str(out), "--quiet"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for_frames(out / "results.xdmf", 3, process)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted"
+    reader = meshio.xdmf.TimeSeriesReader(out / "results.xdmf")
+    reader.read_points_cells()
+    times = [reader.read_data(k)[0] for k in range(reader.num_steps)]
+    assert len(times) == summary["frames"] >= 3
+    assert times == pytest.approx(0.5 * np.arange(len(times)))
+    assert len(list((out / "frames").glob("*.vtu"))) == len(times)
+
+
+def test_an_unstable_run_keeps_its_frames_and_says_why(tmp_path):
+    deck = tmp_path / "unstable.toml"
+    deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 0.5\ndt_safety_factor = 0.5")
+                    .replace("times = [0.1, 0.25]", "interval = 0.01"))
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 3
+    assert "dt_safety_factor" in result.output
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "unstable"
+    reader = meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf")
+    assert reader.num_steps == summary["frames"] >= 1

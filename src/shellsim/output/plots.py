@@ -66,7 +66,7 @@ def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
-        axes[0].legend(fontsize="small", loc="best")
+        figure.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", fontsize="small", ncols=2)
         figure.suptitle(deck.meta.title, fontsize="medium")
         written.append(_save(figure, out_dir / f"{probe.name}.png"))
     written.append(_plot_energy(deck, history, out_dir / "energy.png", size))
@@ -114,12 +114,12 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
     figure = Figure(figsize=size, layout="constrained")
     ax = figure.subplots()
     t = history["time"]
-    for column, label in (("internal_energy", "internal"), ("kinetic_energy", "kinetic"),
-                          ("external_work", "external work"), ("damping_work", "damping work")):
-        ax.plot(t, history[column], label=label)
+    for column, label, style in (("internal_energy", "internal", "-"), ("kinetic_energy", "kinetic", "-"),
+                                 ("external_work", "external work", "--"), ("damping_work", "damping work", "-")):
+        ax.plot(t, history[column], ls=style, label=label)
     balance = history["internal_energy"] + history["kinetic_energy"] + history["damping_work"] - history["external_work"]
     ax.plot(t, balance, color="black", ls=":", label="balance (internal + kinetic + damping - external)")
-    ax.set_xlabel("time")
+    ax.set_xlabel(_labelled("time", unit("time", deck.meta.units)))
     ax.set_ylabel("energy")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")

@@ -209,7 +209,7 @@ def _render_frame(points: np.ndarray, series, values: np.ndarray, on_cells: bool
     rings = np.arange(0, len(points), 16)[:, None] + ELEMENT_RING[None]
     lines = np.hstack([np.full((len(rings), 1), len(ELEMENT_RING)), rings]).ravel()
     plotter.add_mesh(pv.PolyData(points, lines=lines), color="black", line_width=2)
-    plotter.add_text(caption, position="upper_left", font_size=max(6, size[1] // 90), color="black")
+    plotter.add_text(caption, position="upper_left", font_size=max(8, size[1] // 70), color="black")
     _look(plotter, view, points)
     try:
         plotter.screenshot(str(path))

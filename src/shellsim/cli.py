@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import sys
+from contextlib import closing
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
@@ -17,7 +18,8 @@ from rich.console import Console
 from rich.table import Table
 
 from . import __version__
-from .errors import NotYetAvailable, OutputError, ShellsimError
+from .errors import OutputError, ShellsimError
+from .output.folder import output_folder
 
 app = typer.Typer(
     help="Explicit dynamics of thin and thick soft-tissue shells (9-node continuum-based shell).",
@@ -97,7 +99,7 @@ def mesh(
     from .output.mesh_files import write_mesh_vtu
 
     scene = load_deck(deck)
-    folder = _output_folder(out_dir)
+    folder = output_folder(out_dir)
     built = build_mesh(scene, deck.parent)
     write_mesh_vtu(built, folder / "mesh.vtu")
     written = [folder / "mesh.vtu"]
@@ -112,10 +114,6 @@ def mesh(
     out.print(f"sets: {sets}", highlight=False)
     for path in written:
         out.print(f"wrote {path}")
-
-
-def _not_yet(what: str) -> None:
-    raise NotYetAvailable(f"{what} is not available yet in shellsim {__version__}")
 
 
 EXIT_REFERENCE_FAILED = 1
@@ -133,44 +131,15 @@ def run(
     OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
     and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
     reference check fails, 3 when the run goes unstable."""
-    from contextlib import ExitStack, closing
-
     from .deck import load_deck
-    from .deck.resolved import resolved_text
-    from .errors import NumericalError
-    from .geometry import build_mesh
-    from .model import build_model
-    from .output.history import HistoryWriter
+    from .execute import run_scene
     from .output.progress import ProgressDisplay
-    from .output.series import FrameWriter, check_space
-    from .output.summary import summary, write_json
-    from .plan import plan
-    from .solver.run import Listeners, Timed, integrate, output_times, prepare
 
     scene = load_deck(deck)
-    mesh_ = build_mesh(scene, deck.parent)
-    current = prepare(scene, mesh_, build_model(scene, mesh_))
-    folder = _output_folder(out_dir or Path("results") / deck.stem)  # before any step is taken
-    _write_text(folder / "deck.toml", resolved_text(scene, deck, __version__))
-    message = None
-    with ExitStack() as files:
-        history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))
-        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output)))
-        check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
-        progress = files.enter_context(closing(ProgressDisplay(out, scene.solver.end_time, quiet)))
-        writers = Timed(Listeners(history, frames))
-        try:
-            integrate(current, Listeners(writers, progress))
-        except NumericalError as error:
-            message = str(error)
-        except KeyboardInterrupt:
-            message = "interrupted by the user"
-        except OutputError as error:
-            current.status, message = "output failed", str(error)
-        finally:
-            files.close()
-            result = summary(current, deck, plan(scene), message, writers.seconds)
-            write_json(result, folder / "summary.json")
+    folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
+    with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress:
+        current, result = run_scene(scene, deck, folder, progress)
+    message = result["message"]
     if current.status == "interrupted":
         raise KeyboardInterrupt
     if current.status == "output failed":
@@ -184,13 +153,6 @@ def run(
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
-
-
-def _write_text(path: Path, text: str) -> None:
-    try:
-        path.write_text(text, encoding="utf-8")
-    except OSError as error:
-        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
 
 
 def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
@@ -264,7 +226,7 @@ def render(
     if view not in ("iso", *VIEWS):
         raise typer.BadParameter(f"unknown view '{view}'; expected iso, {', '.join(VIEWS)}", param_hint="--view")
     if out_dir is not None:
-        _output_folder(out_dir)
+        output_folder(out_dir)
     for path in render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir):
         out.print(f"wrote {path}")
 
@@ -280,16 +242,52 @@ def plot(
     from .output.plots import plot_run
 
     if out_dir is not None:
-        _output_folder(out_dir)
+        output_folder(out_dir)
     for path in plot_run(results, out_dir):
         out.print(f"wrote {path}")
 
 
 @app.command()
 @reports_errors
-def report(study: Annotated[Path, typer.Argument(help="A study (TOML).")]) -> None:
-    """Error against run time for a study of decks."""
-    _not_yet("'shellsim report' (error-versus-time studies)")
+def report(
+    study: Annotated[Path, typer.Argument(help="A study (TOML): decks and the variants of each.", show_default=False)],
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Report folder [default: results/STUDY-NAME].")] = None,
+    scheduler: Annotated[str | None, typer.Option(help="A running dask scheduler, tcp://HOST:PORT "
+                                                       "[default: a local cluster].")] = None,
+    workers: Annotated[int | None, typer.Option(min=1, help="Workers of the local cluster [default: one per core].")] = None,
+) -> None:
+    """Run every variant of a study through dask and report error against run time:
+    OUT/report.md, OUT/report.csv and OUT/error_vs_time.png, updated as jobs finish, and
+    each run's files under OUT/runs/. Exit code 1 when a job failed or missed a reference."""
+    from rich.progress import Progress
+
+    from .study.executor import open_client, prepare_workers, rows_in_order, run_jobs
+    from .study.jobs import study_jobs
+    from .study.report import read_external, write_report
+    from .study.schema import load_study
+
+    plan_ = load_study(study)
+    folder = output_folder(out_dir or Path("results") / study.stem)
+    jobs = study_jobs(plan_, study, folder)
+    external = read_external(study.parent / plan_.external.path) if plan_.external else []
+    rows: list[dict] = []
+    write_report(folder, plan_.meta.title, rows, len(jobs), external)
+    with open_client(scheduler, workers) as client, Progress(console=out, transient=True) as bar:
+        prepare_workers(client, local=scheduler is None)
+        task = bar.add_task(f"{len(jobs)} jobs", total=len(jobs))
+
+        def on_row(row: dict) -> None:
+            rows.append(row)
+            write_report(folder, plan_.meta.title, list(rows_in_order(jobs, rows)), len(jobs) - len(rows), external)
+            bar.advance(task)
+            error = "-" if row["error_percent"] is None else f"{row['error_percent']:.3g}%"
+            out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
+
+        run_jobs(jobs, client, on_row)
+    for name in ("report.md", "report.csv", "error_vs_time.png"):
+        out.print(f"wrote {folder / name}")
+    if any(r["status"] != "completed" or r["passed"] is False for r in rows):
+        raise typer.Exit(EXIT_REFERENCE_FAILED)
 
 
 @app.command()
@@ -326,19 +324,7 @@ def bench(
     if out_dir is not None:
         from .output.summary import write_json
 
-        write_json({"kernel": kernel, "paths": costs, "plate": ladder}, _output_folder(out_dir) / "bench.json")
-
-
-def _output_folder(path: Path) -> Path:
-    """Create ``path`` and prove it writable before any work is done."""
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".shellsim-write-test"
-        probe.write_bytes(b"")
-        probe.unlink()
-    except OSError as error:
-        raise OutputError(f"output folder '{path}' is not writable: {error.strerror or error}") from None
-    return path
+        write_json({"kernel": kernel, "paths": costs, "plate": ladder}, output_folder(out_dir) / "bench.json")
 
 
 def _summary(scene: Any, built: Any, needs: Any) -> Table:

@@ -1,0 +1,58 @@
+"""One scene run from end to end with every file it leaves behind: what ``shellsim run``
+and each job of a study call."""
+
+from __future__ import annotations
+
+from contextlib import ExitStack, closing
+from pathlib import Path
+
+from . import __version__
+from .deck import Deck
+from .errors import NumericalError, OutputError
+from .solver.run import Listener, Listeners, Run, Timed
+
+
+def _write_text(path: Path, text: str) -> None:
+    try:
+        path.write_text(text, encoding="utf-8")
+    except OSError as error:
+        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+
+
+def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None) -> tuple[Run, dict]:
+    """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
+    (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
+    and summary.json whatever the end. Returns (run, summary); ``run.status`` tells how it
+    ended ('completed', 'unstable', 'interrupted', 'output failed') and the summary's
+    ``message`` why. Renders are left to the caller."""
+    from .deck.resolved import resolved_text
+    from .geometry import build_mesh
+    from .model import build_model
+    from .output.history import HistoryWriter
+    from .output.series import FrameWriter, check_space
+    from .output.summary import summary, write_json
+    from .plan import plan
+    from .solver.run import integrate, output_times, prepare
+
+    mesh = build_mesh(scene, deck_path.parent)
+    current = prepare(scene, mesh, build_model(scene, mesh))
+    _write_text(folder / "deck.toml", resolved_text(scene, deck_path, __version__))
+    message = None
+    with ExitStack() as files:
+        history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))
+        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output)))
+        check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
+        writers = Timed(Listeners(history, frames))
+        try:
+            integrate(current, Listeners(writers, progress or Listener()))
+        except NumericalError as error:
+            message = str(error)
+        except KeyboardInterrupt:
+            message = "interrupted by the user"
+        except OutputError as error:
+            current.status, message = "output failed", str(error)
+        finally:
+            files.close()
+            result = summary(current, deck_path, plan(scene), message, writers.seconds)
+            write_json(result, folder / "summary.json")
+    return current, result

@@ -1,0 +1,92 @@
+"""Running a study's jobs through dask.distributed: a local cluster (one single-threaded
+worker process per core) or an existing scheduler. Rows come back as jobs finish; a job
+that raises becomes a failed row, not the end of the study.
+
+Two known pitfalls are avoided: the numba cache is compiled in the client before any job
+is submitted (concurrent compiles into one cache have crashed dask workers), and meshes
+are built with gmsh initialised for use outside the main thread (dask runs tasks in
+worker threads; see :mod:`shellsim.geometry.session`).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+from .jobs import Job, failed_row, run_job
+
+WARM_UP_DECK = """
+[meta]
+title = "numba cache warm-up"
+[geometry]
+builder = "rectangle"
+length = 1.0
+width = 1.0
+[mesh]
+divisions = { length = 1, width = 1 }
+[material]
+model = "neo_hookean"
+C1 = 1.0
+density = 1.0
+[section]
+thickness = 0.1
+[solver]
+end_time = 1e-3
+[output]
+fields = ["displacement", "cauchy_stress", "pressure_band"]
+"""
+
+
+def warm_numba_cache() -> None:
+    """Compile every kernel a run uses, here, once, so workers only load the cache."""
+    from ..deck import parse_deck
+    from ..execute import run_scene
+
+    with tempfile.TemporaryDirectory() as folder:
+        deck = Path(folder) / "warm_up.toml"
+        deck.write_text(WARM_UP_DECK)
+        run_scene(parse_deck(WARM_UP_DECK), deck, Path(folder))
+
+
+def prepare_workers(client, local: bool) -> None:
+    """Warm the numba cache in the client (local cluster: the workers share it), then run
+    the warm-up on every worker so the first job's wall time holds no loading of kernels."""
+    if local:
+        warm_numba_cache()
+    client.run(warm_numba_cache)
+
+
+def open_client(scheduler: str | None, workers: int | None = None):
+    """A dask client on ``scheduler`` (tcp://host:port), or on a new local cluster of
+    ``workers`` single-threaded processes (default: one per core)."""
+    from dask.distributed import Client
+
+    if scheduler:
+        return Client(scheduler)
+    # the client owns this cluster and shuts it down when closed
+    return Client(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                  dashboard_address=None)
+
+
+def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None]) -> None:
+    """Submit every job to ``client`` and call ``on_row`` with each row as it finishes."""
+    from dask.distributed import as_completed
+
+    futures = {client.submit(run_job, job, key=f"shellsim-{i}-{job.key}", pure=False): job
+               for i, job in enumerate(jobs)}
+    for future in as_completed(futures):
+        job = futures[future]
+        if future.status == "error":
+            on_row(failed_row(job, future.exception()))
+        else:
+            on_row(future.result())
+
+
+def rows_in_order(jobs: list[Job], rows: list[dict]) -> Iterator[dict]:
+    """``rows`` in the study's order of jobs (they arrive in the order jobs finish)."""
+    by_key = {(r["family"], r["variant"]): r for r in rows}
+    for job in jobs:
+        if (job.family, job.label) in by_key:
+            yield by_key[(job.family, job.label)]

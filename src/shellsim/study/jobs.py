@@ -1,0 +1,97 @@
+"""A study's jobs: one deck variant each, run in whichever process the executor picks,
+returning one small row for the report (the run's files stay in its own folder)."""
+
+from __future__ import annotations
+
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import DeckError
+from .schema import Study
+
+
+@dataclass(frozen=True)
+class Job:
+    """deck: the deck file; overrides: dotted deck keys and their values; folder: where
+    the run writes."""
+
+    family: str
+    label: str
+    deck: Path
+    overrides: dict
+    folder: Path
+
+    @property
+    def key(self) -> str:
+        return f"{self.family} / {self.label}"
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "-", text).strip("-").lower() or "run"
+
+
+def study_jobs(study: Study, study_path: Path, out_dir: Path) -> list[Job]:
+    """Every (deck, variant) of ``study`` as a job writing under ``out_dir/runs``."""
+    jobs = []
+    for entry in study.deck:
+        deck = (study_path.parent / entry.path).resolve()
+        family = entry.family or deck.stem
+        for variant in entry.variant:
+            folder = out_dir / "runs" / _slug(family) / _slug(variant.label)
+            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder))
+    return jobs
+
+
+def apply_overrides(data: dict, overrides: dict, name: str) -> dict:
+    """``data`` (a parsed deck) with each dotted key of ``overrides`` replaced; integer
+    parts index arrays of tables ("load.0.value"). Missing tables are created."""
+    for dotted, value in overrides.items():
+        node = data
+        parts = dotted.split(".")
+        try:
+            for part in parts[:-1]:
+                node = node[int(part)] if isinstance(node, list) else node.setdefault(part, {})
+            if isinstance(node, list):
+                node[int(parts[-1])] = value
+            else:
+                node[parts[-1]] = value
+        except (IndexError, ValueError, TypeError, AttributeError):
+            raise DeckError(name, [f"variant key '{dotted}' does not fit the deck"]) from None
+    return data
+
+
+def run_job(job: Job) -> dict:
+    """Run one job; returns its report row (raises on a broken deck or variant)."""
+    from ..deck import deck_from_data
+    from ..execute import run_scene
+    from ..output.folder import output_folder
+
+    text = job.deck.read_text(encoding="utf-8")
+    data = apply_overrides(tomllib.loads(text), job.overrides, str(job.deck))
+    scene = deck_from_data(data, f"{job.deck} [{job.label}]", job.deck.parent)
+    _, summary = run_scene(scene, job.deck, output_folder(job.folder))
+    return row(job, summary)
+
+
+def row(job: Job, summary: dict) -> dict:
+    """The report's row of a finished run: size, steps, time and the worst reference error."""
+    errors = [abs(r["error_percent"]) for r in summary["reference"] if r.get("error_percent") is not None]
+    return {
+        "family": job.family, "variant": job.label, "status": summary["status"],
+        "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
+        "mean_dt": summary["dt"]["mean"], "wall_time_s": summary["wall_time_s"],
+        "us_per_element_step": summary["us_per_element_step"],
+        "error_percent": max(errors) if errors else None,
+        "passed": all(r["passed"] for r in summary["reference"]) if summary["reference"] else None,
+        "message": summary["message"] or "", "folder": str(job.folder),
+    }
+
+
+def failed_row(job: Job, error: BaseException) -> dict:
+    """The row of a job that raised."""
+    return {"family": job.family, "variant": job.label, "status": "failed", "dofs": None, "elements": None,
+            "steps": None, "mean_dt": None, "wall_time_s": None, "us_per_element_step": None,
+            "error_percent": None, "passed": False, "message": str(error) or type(error).__name__,
+            "folder": str(job.folder)}

@@ -1,0 +1,115 @@
+"""The study report: ``report.md`` (a table), ``report.csv`` and ``error_vs_time.png``
+(log-log, one curve per deck family, points labelled by variant, other programs' points
+beside ours), each rewritten atomically as rows arrive."""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from pathlib import Path
+
+from ..errors import DeckError
+
+COLUMNS = ("family", "variant", "status", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
+           "us_per_element_step", "error_percent", "passed", "message", "folder")
+EXTERNAL_COLUMNS = ("family", "program", "label", "error_percent", "wall_time_s")
+
+
+def _replace(path: Path, data: str | bytes) -> None:
+    partial = path.with_name(path.name + ".partial")
+    partial.write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
+    os.replace(partial, path)
+
+
+def read_external(path: Path) -> list[dict]:
+    """Other programs' points: rows of EXTERNAL_COLUMNS, numbers parsed."""
+    try:
+        with open(path, newline="", encoding="utf-8") as file:
+            rows = list(csv.DictReader(file))
+    except OSError as error:
+        raise DeckError(str(path), [f"cannot be read: {error.strerror or error}"]) from None
+    missing = [c for c in EXTERNAL_COLUMNS if rows and c not in rows[0]]
+    if missing:
+        raise DeckError(str(path), [f"missing columns: {', '.join(missing)}"])
+    try:
+        return [r | {"error_percent": float(r["error_percent"]), "wall_time_s": float(r["wall_time_s"])} for r in rows]
+    except ValueError as error:
+        raise DeckError(str(path), [f"not a number: {error}"]) from None
+
+
+def _cell(value) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value).replace("|", "/").replace("\n", " ")
+
+
+def markdown(title: str, rows: list[dict], pending: int) -> str:
+    """The table of ``rows``, with a line saying how many jobs are still running."""
+    header = ("deck", "variant", "status", "DOFs", "steps", "mean dt", "wall time [s]", "us/element-step",
+              "error [%]", "passed", "note")
+    keys = ("family", "variant", "status", "dofs", "steps", "mean_dt", "wall_time_s", "us_per_element_step",
+            "error_percent", "passed", "message")
+    lines = [f"# {title}", "", "Error: the largest relative error over the deck's references (closed-form or "
+             "literature values cited in each deck). Wall time: the whole run, one process per job.", ""]
+    if pending:
+        lines += [f"*{pending} job(s) still running.*", ""]
+    lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(_cell(r[k]) for k in keys) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def csv_text(rows: list[dict]) -> str:
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
+
+
+def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> bytes:
+    """Log-log error against wall time: one line per family in ladder order, each point
+    labelled with its variant; other programs' points as open markers."""
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(8.0, 5.5), layout="constrained")
+    ax = figure.subplots()
+    families = list(dict.fromkeys(r["family"] for r in rows))
+    for family in families:
+        done = [r for r in rows if r["family"] == family and r["error_percent"] and r["wall_time_s"]]
+        if not done:
+            continue
+        line, = ax.plot([r["wall_time_s"] for r in done], [r["error_percent"] for r in done], "o-", label=family)
+        for r in done:
+            ax.annotate(r["variant"], (r["wall_time_s"], r["error_percent"]), textcoords="offset points",
+                        xytext=(4, 4), fontsize="x-small", color=line.get_color())
+    for program in dict.fromkeys(e["program"] for e in external):
+        points = [e for e in external if e["program"] == program]
+        ax.plot([e["wall_time_s"] for e in points], [e["error_percent"] for e in points], "s", mfc="none",
+                label=f"{program} (external)")
+        for e in points:
+            ax.annotate(f"{e['family']} {e['label']}", (e["wall_time_s"], e["error_percent"]),
+                        textcoords="offset points", xytext=(4, -8), fontsize="x-small")
+    if ax.lines:
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    ax.set_xlabel("wall time (s)")
+    ax.set_ylabel("largest reference error (%)")
+    ax.grid(alpha=0.3, which="both")
+    if ax.lines:
+        ax.legend(fontsize="small")
+    figure.suptitle(title, fontsize="medium")
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=110)
+    return buffer.getvalue()
+
+
+def write_report(out_dir: Path, title: str, rows: list[dict], pending: int, external: list[dict]) -> None:
+    """report.md, report.csv and error_vs_time.png in ``out_dir`` for the rows so far."""
+    _replace(out_dir / "report.md", markdown(title, rows, pending))
+    _replace(out_dir / "report.csv", csv_text(rows))
+    _replace(out_dir / "error_vs_time.png", error_vs_time_png(title, rows, external))

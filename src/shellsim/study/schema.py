@@ -1,0 +1,89 @@
+"""The study file (TOML): which decks, which variants of each, and optional points of
+other programs to draw beside ours.
+
+::
+
+    [meta]
+    title = "Quick study"
+
+    [[deck]]
+    path = "../verification/test02_cantilever_uniform_load_3.toml"   # relative to the study
+    family = "Test 2 cantilever"          # one curve of the error-versus-time plot
+
+    [[deck.variant]]
+    label = "3 elements"                  # the deck as it is
+
+    [[deck.variant]]
+    label = "6 elements"
+    set = { "mesh.divisions.length" = 6 } # deck keys replaced (dotted paths; list items by index)
+
+    [external]
+    path = "peers.csv"                    # columns: family, program, label, error_percent, wall_time_s
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import Field, ValidationError, model_validator
+
+from ..deck.types import Section
+from ..errors import DeckError
+
+Text = Annotated[str, Field(strict=True, min_length=1)]
+Value = bool | int | float | str | list
+
+
+class StudyMeta(Section):
+    title: Text
+    description: str = ""
+
+
+class Variant(Section):
+    """One rung of a ladder: a label and the deck keys it replaces."""
+
+    label: Text
+    set: dict[Text, Value] = {}
+
+
+class StudyDeck(Section):
+    """A deck and its ladder (the deck as it is when no variant is given)."""
+
+    path: Text
+    family: str = ""
+    variant: list[Variant] = [Variant(label="as is")]
+
+    @model_validator(mode="after")
+    def _unique_labels(self) -> "StudyDeck":
+        labels = [v.label for v in self.variant]
+        repeated = sorted({label for label in labels if labels.count(label) > 1})
+        if repeated:
+            raise ValueError(f"variant labels of '{self.path}' repeat: {', '.join(repeated)}")
+        return self
+
+
+class External(Section):
+    """Other programs' error and wall time on the same problems (CSV)."""
+
+    path: Text
+
+
+class Study(Section):
+    meta: StudyMeta
+    deck: list[StudyDeck]
+    external: External | None = None
+
+
+def load_study(path: Path) -> Study:
+    """Read and validate a study file; deck paths stay relative to it."""
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+        return Study.model_validate(data)
+    except FileNotFoundError:
+        raise DeckError(str(path), ["file not found"]) from None
+    except tomllib.TOMLDecodeError as error:
+        raise DeckError(str(path), [f"not valid TOML: {error}"]) from None
+    except ValidationError as error:
+        raise DeckError(str(path), [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in error.errors()]) from None

@@ -1,0 +1,86 @@
+"""Studies: deck variants run through a dask LocalCluster, each timed and checked, rows
+streamed into report.md / report.csv / error_vs_time.png; a failed job is a row."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.errors import DeckError
+from shellsim.study.jobs import apply_overrides
+from shellsim.study.report import read_external
+
+from .conftest import ROOT
+
+runner = CliRunner()
+QUICK = ROOT / "decks" / "studies" / "quick.toml"
+
+
+def _rows(folder: Path) -> list[dict]:
+    with open(folder / "report.csv", newline="") as file:
+        return list(csv.DictReader(file))
+
+
+def test_quick_study_runs_every_variant_through_a_local_cluster(tmp_path):
+    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path), "--workers", "2"])
+    assert result.exit_code == 0, result.output
+    rows = _rows(tmp_path)
+    assert [(r["family"].split()[1], r["variant"]) for r in rows] == [("1", "2x2"), ("1", "3x3"), ("7", "M2"), ("7", "M1")]
+    for r in rows:
+        assert r["status"] == "completed" and r["passed"] == "True"
+        assert 0.0 < float(r["error_percent"]) < 2.0 and float(r["wall_time_s"]) > 0.0
+        assert (Path(r["folder"]) / "summary.json").exists()
+    assert int(rows[1]["dofs"]) > int(rows[0]["dofs"])  # the 3x3 variant did refine the mesh
+    table = (tmp_path / "report.md").read_text()
+    assert table.count("| completed |") == 4 and "still running" not in table
+    import imageio.v3 as iio
+
+    assert iio.imread(tmp_path / "error_vs_time.png")[..., :3].std() > 10.0
+
+
+def test_a_failed_job_is_a_row_of_the_report_not_the_end_of_the_study(tmp_path):
+    study = tmp_path / "study.toml"
+    deck = (ROOT / "decks" / "verification" / "test01_plate_step_2x2.toml").as_posix()
+    study.write_text(f"""
+[meta]
+title = "one good job, one broken"
+
+[[deck]]
+path = "{deck}"
+
+[[deck.variant]]
+label = "as shipped"
+
+[[deck.variant]]
+label = "broken"
+set = {{ "mesh.divisions.depth" = 3 }}
+""")
+    result = runner.invoke(app, ["report", str(study), "--out", str(tmp_path / "out"), "--workers", "1"])
+    assert result.exit_code == 1
+    rows = {r["variant"]: r for r in _rows(tmp_path / "out")}
+    assert rows["as shipped"]["status"] == "completed"
+    assert rows["broken"]["status"] == "failed" and "depth" in rows["broken"]["message"]
+
+
+def test_variant_keys_reach_into_tables_and_arrays_of_tables():
+    data = {"mesh": {"divisions": {"length": 2}}, "load": [{"value": 1.0}, {"value": 2.0}]}
+    apply_overrides(data, {"mesh.divisions.length": 4, "load.1.value": 5.0, "solver.mass": "M1"}, "deck")
+    assert data == {"mesh": {"divisions": {"length": 4}}, "load": [{"value": 1.0}, {"value": 5.0}],
+                    "solver": {"mass": "M1"}}
+    with pytest.raises(DeckError, match="load.7.value"):
+        apply_overrides(data, {"load.7.value": 1.0}, "deck")
+
+
+def test_external_points_need_their_columns(tmp_path):
+    good = tmp_path / "peers.csv"
+    good.write_text("family,program,label,error_percent,wall_time_s\nTest 1,other,4x4,0.5,12\n")
+    assert read_external(good) == [{"family": "Test 1", "program": "other", "label": "4x4",
+                                    "error_percent": 0.5, "wall_time_s": 12.0}]
+    bad = tmp_path / "bad.csv"
+    bad.write_text("family,program,error\nTest 1,other,0.5\n")
+    with pytest.raises(DeckError, match="label"):
+        read_external(bad)

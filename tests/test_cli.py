@@ -21,15 +21,6 @@ def test_help_lists_every_command():
         assert command in result.output
 
 
-def test_commands_still_to_come_say_so_and_fail(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # nothing may be written into the checkout
-    result = runner.invoke(app, ["report", "study.toml"])
-    assert result.exit_code == 2
-    assert "not available yet" in result.output
-    assert "Traceback" not in result.output
-    assert not (tmp_path / "results").exists()
-
-
 def test_check_summarises_a_valid_deck():
     result = runner.invoke(app, ["check", str(DEFAULT_DECK)])
     assert result.exit_code == 0, result.output
@@ -74,12 +65,13 @@ def test_mesh_into_an_unwritable_place_is_a_clear_error(tmp_path):
     assert "not writable" in result.output
 
 
-@pytest.mark.parametrize("args", [["render", "nowhere"], ["plot", "nowhere"]])
-def test_render_and_plot_of_a_folder_without_results_is_a_clear_error(args, tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
+@pytest.mark.parametrize("args", [["render", "nowhere"], ["plot", "nowhere"], ["report", "nowhere.toml"]])
+def test_render_plot_and_report_of_missing_inputs_are_clear_errors(args, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # nothing may be written into the checkout
     result = runner.invoke(app, args)
     assert result.exit_code == 2
     assert "nowhere" in result.output and "Traceback" not in result.output
+    assert not (tmp_path / "results").exists()
 
 
 def test_run_of_the_default_scene_completes_and_reports_its_volume(tmp_path):

@@ -22,8 +22,12 @@ run: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
+# The slow tests (the stability suite among them), then the verification and stability
+# studies written into docs/verification/studies/ (their tables and plots are committed).
 verify: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/shellsim report decks/studies/verification.toml --out docs/verification/studies/verification
+	$(BIN)/shellsim report decks/studies/stability.toml --out docs/verification/studies/stability
 
 bench: $(STAMP)
 	$(BIN)/shellsim bench

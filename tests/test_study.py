@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from shellsim.cli import app
 from shellsim.errors import DeckError
-from shellsim.study.jobs import apply_overrides
+from shellsim.study.jobs import Job, apply_overrides, as_expected, row
 from shellsim.study.report import read_external
 
 from .conftest import ROOT
@@ -84,3 +84,15 @@ def test_external_points_need_their_columns(tmp_path):
     bad.write_text("family,program,error\nTest 1,other,0.5\n")
     with pytest.raises(DeckError, match="label"):
         read_external(bad)
+
+
+def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
+    summary = {"status": "unstable", "message": "the run became unstable", "dofs": 5, "elements": 1, "steps": 3,
+               "dt": {"mean": 1e-3}, "wall_time_s": 0.1, "us_per_element_step": 1.0,
+               "reference": [{"passed": False, "error_percent": 98.0}]}
+    on_purpose = row(Job("f", "v", Path("d.toml"), {}, Path("out"), expect="unstable"), summary)
+    assert on_purpose["error_percent"] is None and on_purpose["passed"] is None and as_expected(on_purpose)
+    by_accident = row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary)
+    assert not as_expected(by_accident)
+    completed = row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary | {"status": "completed"})
+    assert completed["error_percent"] == 98.0 and not as_expected(completed)

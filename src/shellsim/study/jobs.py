@@ -15,13 +15,14 @@ from .schema import Study
 @dataclass(frozen=True)
 class Job:
     """deck: the deck file; overrides: dotted deck keys and their values; folder: where
-    the run writes."""
+    the run writes; expect: the status the run should end with."""
 
     family: str
     label: str
     deck: Path
     overrides: dict
     folder: Path
+    expect: str = "completed"
 
     @property
     def key(self) -> str:
@@ -40,7 +41,7 @@ def study_jobs(study: Study, study_path: Path, out_dir: Path) -> list[Job]:
         family = entry.family or deck.stem
         for variant in entry.variant:
             folder = out_dir / "runs" / _slug(family) / _slug(variant.label)
-            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder))
+            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder, variant.expect))
     return jobs
 
 
@@ -76,22 +77,30 @@ def run_job(job: Job) -> dict:
 
 
 def row(job: Job, summary: dict) -> dict:
-    """The report's row of a finished run: size, steps, time and the worst reference error."""
-    errors = [abs(r["error_percent"]) for r in summary["reference"] if r.get("error_percent") is not None]
+    """The report's row of a finished run: size, steps, time and the worst reference error
+    (of a completed run: a run cut short is not measured against its references)."""
+    completed = summary["status"] == "completed"
+    errors = [abs(r["error_percent"]) for r in summary["reference"] if completed and r.get("error_percent") is not None]
     return {
-        "family": job.family, "variant": job.label, "status": summary["status"],
+        "family": job.family, "variant": job.label, "status": summary["status"], "expected": job.expect,
         "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
         "mean_dt": summary["dt"]["mean"], "wall_time_s": summary["wall_time_s"],
         "us_per_element_step": summary["us_per_element_step"],
         "error_percent": max(errors) if errors else None,
-        "passed": all(r["passed"] for r in summary["reference"]) if summary["reference"] else None,
+        "passed": all(r["passed"] for r in summary["reference"]) if summary["reference"] and completed else None,
         "message": summary["message"] or "", "folder": str(job.folder),
     }
 
 
+def as_expected(row: dict) -> bool:
+    """Whether a row ended as its variant expects and met every reference it checked."""
+    return row["status"] == row["expected"] and row["passed"] is not False
+
+
 def failed_row(job: Job, error: BaseException) -> dict:
     """The row of a job that raised."""
-    return {"family": job.family, "variant": job.label, "status": "failed", "dofs": None, "elements": None,
+    return {"family": job.family, "variant": job.label, "status": "failed", "expected": job.expect,
+            "dofs": None, "elements": None,
             "steps": None, "mean_dt": None, "wall_time_s": None, "us_per_element_step": None,
             "error_percent": None, "passed": False, "message": str(error) or type(error).__name__,
             "folder": str(job.folder)}

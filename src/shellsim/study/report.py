@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..errors import DeckError
 
-COLUMNS = ("family", "variant", "status", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
+COLUMNS = ("family", "variant", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
            "us_per_element_step", "error_percent", "passed", "message", "folder")
 EXTERNAL_COLUMNS = ("family", "program", "label", "error_percent", "wall_time_s")
 
@@ -59,7 +59,9 @@ def markdown(title: str, rows: list[dict], pending: int) -> str:
     if pending:
         lines += [f"*{pending} job(s) still running.*", ""]
     lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(_cell(r[k]) for k in keys) + " |" for r in rows]
+    for r in rows:
+        shown = r | {"status": r["status"] + ("" if r["status"] == r["expected"] else f" (expected {r['expected']})")}
+        lines.append("| " + " | ".join(_cell(shown[k]) for k in keys) + " |")
     return "\n".join(lines) + "\n"
 
 

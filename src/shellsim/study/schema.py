@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
@@ -42,10 +42,12 @@ class StudyMeta(Section):
 
 
 class Variant(Section):
-    """One rung of a ladder: a label and the deck keys it replaces."""
+    """One rung of a ladder: a label, the deck keys it replaces, and how the run is
+    expected to end (``unstable`` for a variant made unstable on purpose)."""
 
     label: Text
     set: dict[Text, Value] = {}
+    expect: Literal["completed", "unstable"] = "completed"
 
 
 class StudyDeck(Section):

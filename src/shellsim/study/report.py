@@ -78,7 +78,7 @@ def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> byt
     labelled with its variant; other programs' points as open markers."""
     from matplotlib.figure import Figure
 
-    figure = Figure(figsize=(8.0, 5.5), layout="constrained")
+    figure = Figure(figsize=(8.5, 6.5), layout="constrained")
     ax = figure.subplots()
     families = list(dict.fromkeys(r["family"] for r in rows))
     for family in families:
@@ -103,7 +103,7 @@ def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> byt
     ax.set_ylabel("largest reference error (%)")
     ax.grid(alpha=0.3, which="both")
     if ax.lines:
-        ax.legend(fontsize="small")
+        figure.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncols=3, fontsize="small")
     figure.suptitle(title, fontsize="medium")
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=110)

@@ -10,7 +10,9 @@ import pytest
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 ROOT = Path(__file__).resolve().parents[1]
-DECKS = sorted((ROOT / "decks").rglob("*.toml"))
+#: Scene decks shipped (studies, which name decks, live in decks/studies and are not decks).
+DECKS = sorted(p for p in (ROOT / "decks").rglob("*.toml") if "studies" not in p.relative_to(ROOT / "decks").parts)
+STUDIES = sorted((ROOT / "decks" / "studies").glob("*.toml"))
 
 BASE = """
 [meta]

@@ -14,7 +14,7 @@ from shellsim.errors import DeckError
 from shellsim.study.jobs import Job, apply_overrides, as_expected, row
 from shellsim.study.report import read_external
 
-from .conftest import ROOT
+from .conftest import ROOT, STUDIES
 
 runner = CliRunner()
 QUICK = ROOT / "decks" / "studies" / "quick.toml"
@@ -64,6 +64,21 @@ set = {{ "mesh.divisions.depth" = 3 }}
     rows = {r["variant"]: r for r in _rows(tmp_path / "out")}
     assert rows["as shipped"]["status"] == "completed"
     assert rows["broken"]["status"] == "failed" and "depth" in rows["broken"]["message"]
+
+
+@pytest.mark.parametrize("path", STUDIES, ids=lambda p: p.name)
+def test_every_variant_of_every_shipped_study_is_a_valid_deck(path, tmp_path):
+    import tomllib
+
+    from shellsim.deck import deck_from_data
+    from shellsim.study.jobs import study_jobs
+    from shellsim.study.schema import load_study
+
+    jobs = study_jobs(load_study(path), path, tmp_path)
+    assert jobs
+    for job in jobs:
+        data = apply_overrides(tomllib.loads(job.deck.read_text()), job.overrides, str(job.deck))
+        deck_from_data(data, job.key, job.deck.parent)  # raises DeckError on a broken variant
 
 
 def test_variant_keys_reach_into_tables_and_arrays_of_tables():

@@ -198,6 +198,27 @@ def box_volume(corners: np.ndarray) -> float:
     return float(np.prod(np.ptp(corners, axis=0)))
 
 
+def test_a_solid_series_is_written_and_rendered(tmp_path):
+    """output.solid: hexahedra between the faces in the series, a cell per integration
+    point, and a render of them."""
+    deck = tmp_path / "solid.toml"
+    deck.write_text(PLATE.replace('formats = ["xdmf", "vtu"]', 'formats = ["xdmf"]\nsolid = true'))
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    reader = meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf")
+    points, cells = reader.read_points_cells()
+    nt = load_deck(deck).section.points_through_thickness
+    assert cells[0].type == "hexahedron" and cells[0].data.shape == (4 * 9 * nt, 8)
+    assert points.shape == (4 * (nt + 1) * 16, 3)
+    _, point_data, cell_data = reader.read_data(reader.num_steps - 1)
+    assert cell_data["von_mises"][0].shape == (4 * 9 * nt,) and "von_mises_nodal" not in point_data
+    result = runner.invoke(app, ["render", str(tmp_path / "out"), "--field", "von_mises", "--size", "400x300"])
+    assert result.exit_code == 0, result.output
+    (png,) = (tmp_path / "out" / "renders").glob("von_mises_iso_*.png")
+    size, contrast = _picture_contrast(png)
+    assert size == (400, 300) and contrast > 20.0
+
+
 def test_not_enough_disk_space_is_reported_before_the_run(tmp_path):
     with pytest.raises(OutputError, match="MB free"):
         check_space(tmp_path, 10 ** 18)

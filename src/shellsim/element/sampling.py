@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 
 from ..tensor3 import congruence
-from .frames import lamina_frame
+from .kernels import _gather, _lamina_to_global, _point_geometry
 
 
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,
@@ -33,27 +33,16 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     ``green``, the Green-Lagrange strain (F^T F - I) / 2 in global axes with
     F = dx/d(r, s, t) (dX/d(r, s, t))^-1.
     """
-    jac, q = np.empty((3, 3)), np.empty((3, 3))
-    F, eye = np.empty((3, 3)), np.eye(3)
+    xe, de, he = np.empty((9, 3)), np.empty((9, 3)), np.empty(9)
+    jac, jinv, q, F, eye = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.eye(3)
+    gN, gM = np.empty((9, 3)), np.empty((9, 3))
     for e in range(conn.shape[0]):
+        _gather(conn[e], x, d, h, xe, de, he)
         for p in range(N.shape[0]):
             for k in range(tz.shape[0]):
-                jac[:] = 0.0
-                for a in range(9):
-                    node = conn[e, a]
-                    half = 0.5 * h[node]
-                    for i in range(3):
-                        pos = x[node, i] + tz[k] * half * d[node, i]
-                        jac[i, 0] += dNr[p, a] * pos
-                        jac[i, 1] += dNs[p, a] * pos
-                        jac[i, 2] += N[p, a] * half * d[node, i]
-                lamina_frame(jac, q)
-                s11, s22, s12, s13, s23 = stress[e, p, k]
-                local = lamina[e, p, k]
-                local[0, 0], local[0, 1], local[0, 2] = s11, s12, s13
-                local[1, 0], local[1, 1], local[1, 2] = s12, s22, s23
-                local[2, 0], local[2, 1], local[2, 2] = s13, s23, 0.0
-                congruence(q.T, local, q.T, cauchy[e, p, k])
+                _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
+                _lamina_to_global(stress[e, p, k], eye, lamina[e, p, k])  # the lamina frame is its own
+                _lamina_to_global(stress[e, p, k], q, cauchy[e, p, k])
                 congruence(jac, jac0_inv[e, p, k], eye, F)
                 strain = green[e, p, k]
                 congruence(F.T, eye, F.T, strain)

@@ -43,6 +43,8 @@ UNITS = {"SI": {"length": "m", "stress": "Pa", "time": "s"},
 SUB_BOUNDS = -1.0 + np.concatenate([[0.0], np.cumsum(gauss_rule(3)[1])])
 #: Natural coordinates of the 4 x 4 sub-cell corners, r fastest. Shape (16, 2).
 CORNER_RS = np.array([(r, s) for s in SUB_BOUNDS for r in SUB_BOUNDS])
+#: Shape functions at the corners. Shape (16, 9).
+CORNER_N = shape(CORNER_RS)
 #: Corners of the sub-cell of in-plane point q = i_r + 3 i_s (counter-clockwise). Shape (9, 4).
 SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in range(3) for i in range(3))])
 
@@ -77,7 +79,7 @@ class OutputMesh:
 def _at_corners(nodal: np.ndarray, conn: np.ndarray, layers: int) -> np.ndarray:
     """Nodal values (n, ...) interpolated to the sub-cell corners of each element and
     repeated on each of ``layers`` corner layers: (ne * layers * 16, ...)."""
-    values = np.einsum("ca,ea...->ec...", shape(CORNER_RS), nodal[conn])
+    values = np.einsum("ca,ea...->ec...", CORNER_N, nodal[conn])
     return np.repeat(values[:, None], layers, axis=1).reshape(-1, *nodal.shape[1:])
 
 
@@ -112,6 +114,8 @@ def von_mises(sigma: np.ndarray) -> np.ndarray:
 
 def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     """Each requested cell field at every integration point, (ne, nq, nt, ...)."""
+    if not set(fields) & set(CELL_FIELDS):
+        return {}  # no stress or strain asked for: nothing to sample
     lamina, cauchy, green = sim.point_tensors()
     values = {"cauchy_stress": cauchy, "lamina_stress": lamina, "green_lagrange_strain": green,
               "pressure_band": -np.trace(cauchy, axis1=-2, axis2=-1) / 3.0}

@@ -142,7 +142,8 @@ class StoredSeries:
         if (folder / XDMF_NAME).exists():
             self._reader = meshio.xdmf.TimeSeriesReader(folder / XDMF_NAME)
             points, cells = self._reader.read_points_cells()
-            self.times = [self._reader.read_data(k)[0] for k in range(self._reader.num_steps)]
+            # the times from the XML alone: reading each frame's data here would read it twice
+            self.times = [float(t.get("Value")) for t in ET.parse(folder / XDMF_NAME).getroot().iter("Time")]
         elif (folder / PVD_NAME).exists():
             self._reader = None
             index = ET.parse(folder / PVD_NAME).getroot().iter("DataSet")

@@ -112,7 +112,12 @@ def mesh(
     out.print(f"{scene.meta.title}: {built.n_elements} elements, {built.n_nodes} nodes, "
               f"{5 * built.n_nodes} DOFs")
     out.print(f"sets: {sets}", highlight=False)
-    for path in written:
+    _announce(written)
+
+
+def _announce(paths: Any) -> None:
+    """One 'wrote PATH' line per file written."""
+    for path in paths:
         out.print(f"wrote {path}")
 
 
@@ -160,9 +165,9 @@ def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
     from .output.render import render_field
 
     for picture in scene.output.render:
-        for path in render_field(folder, picture.field, picture.frame, picture.view, picture.size):
-            if not quiet:
-                out.print(f"wrote {path}")
+        written = render_field(folder, picture.field, picture.frame, picture.view, picture.size)
+        if not quiet:
+            _announce(written)
 
 
 def _run_report(result: dict, folder: Path) -> Table | str:
@@ -225,10 +230,7 @@ def render(
 
     if view not in ("iso", *VIEWS):
         raise typer.BadParameter(f"unknown view '{view}'; expected iso, {', '.join(VIEWS)}", param_hint="--view")
-    if out_dir is not None:
-        output_folder(out_dir)
-    for path in render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir):
-        out.print(f"wrote {path}")
+    _announce(render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir))
 
 
 @app.command()
@@ -241,10 +243,7 @@ def plot(
     follows a time curve) with the deck's references, and the energies (PNG)."""
     from .output.plots import plot_run
 
-    if out_dir is not None:
-        output_folder(out_dir)
-    for path in plot_run(results, out_dir):
-        out.print(f"wrote {path}")
+    _announce(plot_run(results, out_dir))
 
 
 @app.command()
@@ -285,8 +284,7 @@ def report(
             out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
 
         run_jobs(jobs, client, on_row)
-    for name in ("report.md", "report.csv", "error_vs_time.png"):
-        out.print(f"wrote {folder / name}")
+    _announce(folder / name for name in ("report.md", "report.csv", "error_vs_time.png"))
     if not all(as_expected(r) for r in rows):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..deck import parse_deck
 from ..errors import OutputError
+from .folder import output_folder
 from .fields import unit
 
 PLOTS_DIR = "plots"
@@ -48,8 +49,7 @@ def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float
     from matplotlib.figure import Figure
 
     deck, history = _read(folder)
-    out_dir = out_dir or folder / PLOTS_DIR
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_folder(out_dir or folder / PLOTS_DIR)
     times = history["time"]
     load = _load_axis(deck, times)
     written = []

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..element.shape import shape
 from ..errors import OutputError
+from .folder import output_folder
 from ..mesh import Mesh
 
 #: Points drawn along each element edge so curved edges look curved.
@@ -170,8 +171,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     title, units = _series_units(folder)
     label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
     bar = f"{label} {picked[0][2]}".strip() + (f" ({unit(field, units)})" if unit(field, units) not in ("-", "") else "")
-    out_dir = out_dir or folder / RENDERS_DIR
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_folder(out_dir or folder / RENDERS_DIR)
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []
     for index, (point_data, _), (values, on_cells, _) in zip(indices, frames, picked):

@@ -14,7 +14,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 from .curves import Curve
 from .geometry import BUILDERS, Geometry
 from .material import MATERIALS, Material
-from .types import Count, Name, NonNegative, Positive, Real, Section, Vec3
+from .types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
 
 Axis = Literal["x", "y", "z"]
 
@@ -306,8 +306,7 @@ class Output(Section):
         unwritten = sorted({r.field for r in self.render} - set(self.fields))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
-        names = [p.name for p in self.probe]
-        duplicates = sorted({n for n in names if names.count(n) > 1})
+        duplicates = repeated([p.name for p in self.probe])
         if duplicates:
             raise ValueError(f"probe names must be unique; repeated: {', '.join(duplicates)}")
         return self

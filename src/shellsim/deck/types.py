@@ -17,6 +17,11 @@ Vec3 = tuple[Real, Real, Real]
 Name = Annotated[str, Field(strict=True, pattern=r"^[A-Za-z][A-Za-z0-9_\-]*$")]
 
 
+def repeated(names: list[str]) -> list[str]:
+    """The names that occur more than once in ``names``, sorted."""
+    return sorted({name for name in names if names.count(name) > 1})
+
+
 class Section(BaseModel):
     """Base of every deck table: unknown keys are errors, values are immutable."""
 

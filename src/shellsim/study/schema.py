@@ -29,7 +29,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from ..deck.types import Section
+from ..deck.types import Section, repeated
 from ..errors import DeckError
 
 Text = Annotated[str, Field(strict=True, min_length=1)]
@@ -59,10 +59,9 @@ class StudyDeck(Section):
 
     @model_validator(mode="after")
     def _unique_labels(self) -> "StudyDeck":
-        labels = [v.label for v in self.variant]
-        repeated = sorted({label for label in labels if labels.count(label) > 1})
-        if repeated:
-            raise ValueError(f"variant labels of '{self.path}' repeat: {', '.join(repeated)}")
+        twice = repeated([v.label for v in self.variant])
+        if twice:
+            raise ValueError(f"variant labels of '{self.path}' repeat: {', '.join(twice)}")
         return self
 
 

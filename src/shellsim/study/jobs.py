@@ -76,19 +76,27 @@ def run_job(job: Job) -> dict:
     return row(job, summary)
 
 
+#: The columns of a report row, in order.
+COLUMNS = ("family", "variant", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
+           "us_per_element_step", "error_percent", "passed", "message", "folder")
+
+
+def _identity(job: Job) -> dict:
+    return {"family": job.family, "variant": job.label, "expected": job.expect, "folder": str(job.folder)}
+
+
 def row(job: Job, summary: dict) -> dict:
     """The report's row of a finished run: size, steps, time and the worst reference error
     (of a completed run: a run cut short is not measured against its references)."""
     completed = summary["status"] == "completed"
     errors = [abs(r["error_percent"]) for r in summary["reference"] if completed and r.get("error_percent") is not None]
-    return {
-        "family": job.family, "variant": job.label, "status": summary["status"], "expected": job.expect,
-        "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
+    return _identity(job) | {
+        "status": summary["status"], "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
         "mean_dt": summary["dt"]["mean"], "wall_time_s": summary["wall_time_s"],
         "us_per_element_step": summary["us_per_element_step"],
         "error_percent": max(errors) if errors else None,
         "passed": all(r["passed"] for r in summary["reference"]) if summary["reference"] and completed else None,
-        "message": summary["message"] or "", "folder": str(job.folder),
+        "message": summary["message"] or "",
     }
 
 
@@ -99,8 +107,5 @@ def as_expected(row: dict) -> bool:
 
 def failed_row(job: Job, error: BaseException) -> dict:
     """The row of a job that raised."""
-    return {"family": job.family, "variant": job.label, "status": "failed", "expected": job.expect,
-            "dofs": None, "elements": None,
-            "steps": None, "mean_dt": None, "wall_time_s": None, "us_per_element_step": None,
-            "error_percent": None, "passed": False, "message": str(error) or type(error).__name__,
-            "folder": str(job.folder)}
+    return dict.fromkeys(COLUMNS) | _identity(job) | {
+        "status": "failed", "passed": False, "message": str(error) or type(error).__name__}

@@ -10,9 +10,8 @@ import os
 from pathlib import Path
 
 from ..errors import DeckError
+from .jobs import COLUMNS
 
-COLUMNS = ("family", "variant", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
-           "us_per_element_step", "error_percent", "passed", "message", "folder")
 EXTERNAL_COLUMNS = ("family", "program", "label", "error_percent", "wall_time_s")
 
 

@@ -1,5 +1,6 @@
-"""The semi-analytic tube-inflation reference against the tables of benchmarks.md
-(Tests 9 and 10 stand-ins) and the exact resultant checks any solution must meet."""
+"""The closed-form references against benchmarks.md: tube inflation (the tables of the
+Tests 9 and 10 stand-ins, and the exact resultants any solution must meet) and the
+Mindlin plate of Test 1 (1A, NAFEMS 21T, and its Kirchhoff limit)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import pytest
 from scipy.integrate import quad
 
 from shellsim.verify.analytic import through_wall_stresses, tube_inflation
+from shellsim.verify.plate import plate_step_reference
 
 AORTA = dict(inner_radius=10.0e-3, wall_thickness=1.5e-3, C=(25e3, 20.0, 10.0, 10.0))
 CAROTID = dict(inner_radius=1.2e-3, wall_thickness=0.5e-3, C=(20e3, 8.0, 4.0, 4.0))
@@ -43,3 +45,25 @@ def test_through_wall_stresses_meet_the_exact_resultants():
     axial = over_r(lambda R: 2 * np.pi * radius(R) * through_wall_stresses(P, R, **tube)[2][0])
     assert hoop == pytest.approx(P * r_i, rel=1e-7)
     assert axial == pytest.approx(np.pi * r_i**2 * P, rel=1e-7)
+
+
+@pytest.mark.parametrize("plate, deflection, frequency", [
+    # benchmarks.md Test 1A: w_M = 1.28387e-4 m, Mindlin w11 = 6028.5 rad/s
+    (dict(side=0.25, thickness=0.0125, E=70e9, nu=0.3, density=2700.0, pressure=100e3), 1.28387e-4, 6028.5),
+    # NAFEMS 21T (benchmarks.md Test 1B): 2.333 mm static, 288.379 rad/s (our Mindlin 288.47)
+    (dict(side=10.0, thickness=1.0, E=200e9, nu=0.3, density=8000.0, pressure=1e6), 2.3330e-3, 288.47),
+])
+def test_plate_reference_matches_benchmarks(plate, deflection, frequency):
+    w, omega = plate_step_reference(**plate)
+    assert w == pytest.approx(deflection, rel=5e-5)
+    assert omega == pytest.approx(frequency, rel=5e-5)
+
+
+def test_thin_plate_reference_tends_to_kirchhoff():
+    """At a / h = 1e4 the Mindlin values meet Kirchhoff's: w = 0.0040624 q a^4 / D
+    (Timoshenko & Woinowsky-Krieger) and w11 = 2 (pi/a)^2 sqrt(D / (rho h))."""
+    a, h, E, nu, rho, q = 0.25, 2.5e-5, 70e9, 0.3, 2700.0, 1.6e-6
+    D = E * h**3 / (12 * (1 - nu**2))
+    w, omega = plate_step_reference(a, h, E, nu, rho, q)
+    assert w == pytest.approx(0.0040624 * q * a**4 / D, rel=2e-5)
+    assert omega == pytest.approx(2 * (np.pi / a) ** 2 * np.sqrt(D / (rho * h)), rel=1e-6)

@@ -30,7 +30,7 @@ def test_stability_suite(tmp_path):
     assert result.exit_code == 0, result.output  # every run ended as expected
     with open(tmp_path / "report.csv", newline="") as file:
         rows = list(csv.DictReader(file))
-    assert len(rows) == 10
+    assert len(rows) == 13
     for row in rows:
         summary = json.loads((Path(row["folder"]) / "summary.json").read_text())
         if row["family"] == "unstable by construction":

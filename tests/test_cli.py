@@ -46,6 +46,18 @@ def test_check_warns_about_a_safety_factor_below_one(tmp_path):
     assert "unstable" in result.output
 
 
+def test_check_gives_the_step_and_suggests_m1_for_a_thin_shell_on_m2(tmp_path):
+    thin = ROOT / "decks" / "stability" / "thin_plate_1e-3.toml"
+    shipped = runner.invoke(app, ["check", str(thin)])  # M1: no hint
+    assert shipped.exit_code == 0 and "hint" not in shipped.output
+    assert "time step" in shipped.output and "steps to the end" in shipped.output
+    deck = tmp_path / "thin_m2.toml"
+    deck.write_text(thin.read_text().replace('mass = "M1"', 'mass = "M2"'))
+    result = runner.invoke(app, ["check", str(deck)])
+    assert result.exit_code == 0
+    assert 'hint: solver.mass = "M1" would take a' in " ".join(result.output.split())
+
+
 def test_mesh_writes_the_vtu_and_the_png(tmp_path):
     import meshio
 

@@ -70,14 +70,24 @@ def main(
 @app.command()
 @reports_errors
 def check(deck: DeckPath) -> None:
-    """Validate a deck, build its mesh, and summarise the scene."""
+    """Validate a deck, build its mesh, summarise the scene, and say what its time step and
+    step count will be."""
     from .deck import load_deck
     from .geometry import build_mesh
+    from .model import build_model
     from .plan import plan
+    from .solver.run import step_outlook
 
     scene = load_deck(deck)
     mesh = build_mesh(scene, deck.parent)
-    out.print(_summary(scene, mesh, plan(scene)))
+    outlook = step_outlook(scene, build_model(scene, mesh))
+    out.print(_summary(scene, mesh, plan(scene), outlook))
+    if scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
+        err.print(
+            f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "
+            "step: with M2 the rotary inertia of this thin shell sets the critical step (M1 floors it, "
+            "thesis 3.14.1; on coarse meshes that slows bending: Test 1 on 2x2 peaks 7% late, docs/verification.md)"
+        )
     if scene.solver.dt_safety_factor < 1.0:
         err.print(
             f"[yellow]warning:[/] solver.dt_safety_factor = {scene.solver.dt_safety_factor} < 1 "
@@ -254,6 +264,9 @@ def report(
     scheduler: Annotated[str | None, typer.Option(help="A running dask scheduler, tcp://HOST:PORT "
                                                        "[default: a local cluster].")] = None,
     workers: Annotated[int | None, typer.Option(min=1, help="Workers of the local cluster [default: one per core].")] = None,
+    embed_in: Annotated[Path | None, typer.Option("--embed", help="Also write the table into this markdown file, "
+                                                  "between '<!-- report STUDY-NAME -->' and "
+                                                  "'<!-- end report STUDY-NAME -->'.")] = None,
 ) -> None:
     """Run every variant of a study through dask and report error against run time:
     OUT/report.md, OUT/report.csv and OUT/error_vs_time.png, updated as jobs finish, and
@@ -263,10 +276,12 @@ def report(
 
     from .study.executor import open_client, prepare_workers, rows_in_order, run_jobs
     from .study.jobs import as_expected, study_jobs
-    from .study.report import read_external, write_report
+    from .study.report import embed, embed_span, read_external, write_report
     from .study.schema import load_study
 
     plan_ = load_study(study)
+    if embed_in is not None:
+        embed_span(embed_in, study.stem)  # a missing marker is found now, not after the runs
     folder = output_folder(out_dir or Path("results") / study.stem)
     jobs = study_jobs(plan_, study, folder)
     external = read_external(study.parent / plan_.external.path) if plan_.external else []
@@ -284,7 +299,11 @@ def report(
             out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
 
         run_jobs(jobs, client, on_row)
-    _announce(folder / name for name in ("report.md", "report.csv", "error_vs_time.png"))
+    written = [folder / name for name in ("report.md", "report.csv", "error_vs_time.png")]
+    if embed_in is not None:
+        embed(embed_in, study.stem, list(rows_in_order(jobs, rows)))
+        written.append(embed_in)
+    _announce(written)
     if not all(as_expected(r) for r in rows):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
 
@@ -326,7 +345,11 @@ def bench(
         write_json({"kernel": kernel, "paths": costs, "plate": ladder}, output_folder(out_dir) / "bench.json")
 
 
-def _summary(scene: Any, built: Any, needs: Any) -> Table:
+#: ``check`` suggests M1 to an M2 scene when M1's critical step is this many times larger.
+THIN_SHELL_GAIN = 2.0
+
+
+def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     table = Table(title=scene.meta.title, show_header=False, title_justify="left")
     table.add_column(style="bold")
     table.add_column()
@@ -356,6 +379,8 @@ def _summary(scene: Any, built: Any, needs: Any) -> Table:
     table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
                             f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
                             + (f", damping {sv.damping}/s" if sv.damping else ""))
+    table.add_row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
+                               f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
     for ref in scene.reference:
         tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
         table.add_row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "

@@ -8,6 +8,7 @@ history time, ``listener.on_frame(run)`` at t = 0 and at every output time, and
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -283,6 +284,18 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     finally:
         run.wall_time = time.perf_counter() - start
     return run
+
+
+def step_outlook(deck: Deck, model: Model) -> dict:
+    """What the run's time step will be, before it starts: the critical step at t = 0
+    [time] with each lumping, ``{"M1": .., "M2": ..}``, and ``steps``, the number of steps
+    to the end time with the deck's lumping and safety factor at that step (a stiffening
+    scene takes more)."""
+    critical = {mass: Simulation(dataclasses.replace(model, mass=mass)).critical_time_step() for mass in ("M1", "M2")}
+    dt = critical[deck.solver.mass] / deck.solver.dt_safety_factor
+    if deck.solver.dt_max is not None:
+        dt = min(dt, deck.solver.dt_max)
+    return critical | {"steps": math.ceil(deck.solver.end_time / dt)}
 
 
 def dt_statistics(run: Run) -> dict:

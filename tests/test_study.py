@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from shellsim.cli import app
 from shellsim.errors import DeckError
 from shellsim.study.jobs import Job, apply_overrides, as_expected, row
-from shellsim.study.report import read_external
+from shellsim.study.report import read_external, table
 
 from .conftest import ROOT, STUDIES
 
@@ -26,7 +26,9 @@ def _rows(folder: Path) -> list[dict]:
 
 
 def test_quick_study_runs_every_variant_through_a_local_cluster(tmp_path):
-    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path), "--workers", "2"])
+    record = tmp_path / "record.md"
+    record.write_text("# Record\n\nbefore\n<!-- report quick -->\nold table\n<!-- end report quick -->\nafter\n")
+    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path), "--workers", "2", "--embed", str(record)])
     assert result.exit_code == 0, result.output
     rows = _rows(tmp_path)
     assert [(r["family"].split()[1], r["variant"]) for r in rows] == [("1", "2x2"), ("1", "3x3"), ("7", "M2"), ("7", "M1")]
@@ -37,6 +39,10 @@ def test_quick_study_runs_every_variant_through_a_local_cluster(tmp_path):
     assert int(rows[1]["dofs"]) > int(rows[0]["dofs"])  # the 3x3 variant did refine the mesh
     table = (tmp_path / "report.md").read_text()
     assert table.count("| completed |") == 4 and "still running" not in table
+    embedded = record.read_text()  # the same table, between the markers, the rest kept
+    assert embedded.startswith("# Record\n\nbefore\n<!-- report quick -->\n| deck |")
+    assert embedded.endswith("<!-- end report quick -->\nafter\n") and "old table" not in embedded
+    assert embedded.count("| completed |") == 4
     import imageio.v3 as iio
 
     assert iio.imread(tmp_path / "error_vs_time.png")[..., :3].std() > 10.0
@@ -64,6 +70,16 @@ set = {{ "mesh.divisions.depth" = 3 }}
     rows = {r["variant"]: r for r in _rows(tmp_path / "out")}
     assert rows["as shipped"]["status"] == "completed"
     assert rows["broken"]["status"] == "failed" and "depth" in rows["broken"]["message"]
+
+
+def test_a_record_without_the_markers_is_refused_before_any_job_runs(tmp_path):
+    record = tmp_path / "record.md"
+    record.write_text("# Record\n")
+    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path / "out"), "--embed", str(record)])
+    assert result.exit_code == 2
+    assert "<!-- report quick -->" in result.output and "<!-- end report quick -->" in result.output
+    assert not (tmp_path / "out").exists()
+    assert record.read_text() == "# Record\n"
 
 
 @pytest.mark.parametrize("path", STUDIES, ids=lambda p: p.name)
@@ -111,3 +127,16 @@ def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
     assert not as_expected(by_accident)
     completed = row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary | {"status": "completed"})
     assert completed["error_percent"] == 98.0 and not as_expected(completed)
+
+
+def test_a_coarse_mesh_expected_to_miss_is_judged_by_missing():
+    summary = {"status": "completed", "message": "", "dofs": 5, "elements": 1, "steps": 3, "dt": {"mean": 1e-3},
+               "wall_time_s": 0.1, "us_per_element_step": 1.0, "reference": [{"passed": False, "error_percent": 3.8}]}
+    coarse = Job("f", "1x1", Path("d.toml"), {}, Path("out"), expect="missed")
+    missed = row(coarse, summary)
+    assert missed["error_percent"] == 3.8 and as_expected(missed)
+    assert "as expected" in table([missed]) and "(expected" not in table([missed])
+    met = row(coarse, summary | {"reference": [{"passed": True, "error_percent": 1.0}]})
+    assert not as_expected(met) and "completed (expected missed)" in table([met])  # a change worth a look
+    unstable = row(coarse, summary | {"status": "unstable"})
+    assert not as_expected(unstable)

@@ -19,15 +19,17 @@ $(STAMP): pyproject.toml
 run: $(STAMP)
 	$(BIN)/shellsim run $(DECK) --out $(OUT)
 
+# One test process per core (pytest-xdist); the numba cache is compiled once, before them.
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto
 
 # The slow tests (the stability suite among them), then the verification and stability
-# studies written into docs/verification/studies/ (their tables and plots are committed).
+# studies written into docs/verification/studies/ and their tables into
+# docs/verification.md (all committed).
 verify: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
-	$(BIN)/shellsim report decks/studies/verification.toml --out docs/verification/studies/verification
-	$(BIN)/shellsim report decks/studies/stability.toml --out docs/verification/studies/stability
+	$(BIN)/shellsim report decks/studies/verification.toml --out docs/verification/studies/verification --embed docs/verification.md
+	$(BIN)/shellsim report decks/studies/stability.toml --out docs/verification/studies/stability --embed docs/verification.md
 
 bench: $(STAMP)
 	$(BIN)/shellsim bench

@@ -32,6 +32,16 @@ end_time = 1.0
 """
 
 
+def pytest_configure(config):
+    """Under pytest-xdist, compile the numba cache here, once, before the workers start:
+    workers compiling the same kernels into one cache at once have crashed (the pitfall
+    the study executor avoids the same way)."""
+    if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        from shellsim.study.executor import warm_numba_cache
+
+        warm_numba_cache()
+
+
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     """A valid deck: ``base`` + [geometry] body + extra tables."""
     return f"{base}\n[geometry]\n{geometry}\n{extra}"

@@ -1,41 +1,104 @@
-"""Verification decks as a regression suite: each deck listed here runs to its end and
-every one of its [reference] checks (closed-form or literature values, cited in the deck)
-passes. Test 9 (test09_aorta_slow_M2) runs through the command line in test_output.py,
-its references checked by the exit code. Decks left out are slower or not yet within their
-references (docs/verification.md)."""
+"""Every verification deck as a regression suite: each runs (as shipped, or as a coarse
+or shortened variant where the deck takes minutes) and meets every [reference] check it
+reaches (closed-form or literature values, cited in the deck). A deck this file does not
+run is listed in ELSEWHERE with where it is checked or why not; a test keeps the two lists
+complete, so a new deck cannot go unchecked."""
 
 from __future__ import annotations
+
+import tomllib
 
 import numpy as np
 import pytest
 
-from shellsim.deck import load_deck
+from shellsim.deck import deck_from_data
 from shellsim.geometry import build_mesh
 from shellsim.model import build_model
+from shellsim.solver.explicit import EXTERNAL
 from shellsim.solver.run import integrate, prepare
+from shellsim.study.jobs import apply_overrides
 from shellsim.verify.check import check
 
 from .conftest import ROOT
 
-DECKS = [
-    "test01_nafems_21t_4x4.toml",
-    "test02_cantilever_uniform_load_3.toml",
-    "test03_strip_moment_irregular3_thick.toml",
-    "test07_thick_cylinder_2x3_nu049.toml",
-    "test07_thick_cylinder_2x3_nu04999.toml",
-    "test05_scordelis_lo_6x6.toml",
-    "test06_twisted_beam_8_inplane.toml",
-    "test06_twisted_beam_8_outofplane.toml",
-    "test10_carotid_slow_M2.toml",
-]
+VERIFICATION = ROOT / "decks" / "verification"
+
+#: deck -> overrides of its coarse variant (dotted keys, as a study's variants); {} = as shipped.
+#: A variant with a shorter end_time is checked on the references it reaches.
+RUN = {
+    "test01_nafems_21t_4x4.toml": {},
+    "test02_cantilever_uniform_load_3.toml": {},
+    "test03_strip_moment_regular3.toml": {},
+    "test03_strip_moment_irregular3_thick.toml": {},
+    # Test 4 to 108 degrees on 6 square elements: with nu = 0 and loads per unit width the
+    # width is free, and the wider, longer elements take a 3.7 times larger step.
+    "test04_strip_rollup_M1.toml": {"geometry.width": 2.0, "mesh.points.tip": [12.0, 2.0, 0.0],
+                                    "mesh.divisions.length": 6, "solver.end_time": 1.2},
+    "test05_scordelis_lo_6x6.toml": {},
+    "test06_twisted_beam_8_inplane.toml": {},
+    "test06_twisted_beam_8_outofplane.toml": {},
+    "test07_thick_cylinder_2x3_nu049.toml": {},
+    "test07_thick_cylinder_2x3_nu04999.toml": {},
+    "test09_aorta_slow_M1.toml": {},
+    "test10_carotid_slow_M1.toml": {},
+    "test10_carotid_slow_M2.toml": {},
+}
+
+#: deck -> where it is checked instead, or why it is not run here.
+ELSEWHERE = {
+    "test01_plate_step_2x2.toml": "tests/test_solver.py, in both formulations",
+    "test03_strip_moment_irregular3.toml": "misses its references: too stiff on trapezoids (docs/verification.md, "
+                                           "Distortion); the thick strip on the same mesh is run",
+    "test03_strip_moment_irregular4.toml": "as test03_strip_moment_irregular3",
+    "test03_strip_moment_regular4.toml": "its coarse variant is test03_strip_moment_regular3",
+    "test04_strip_rollup_M2.toml": "M2's step falls with the thickness: 10 times test04_strip_rollup_M1's; make verify",
+    "test05_scordelis_lo_16x16.toml": "its 1% of the converged value needs the fine mesh (40 min); "
+                                      "test05_scordelis_lo_6x6 is the coarse variant, against the 6x6 reference",
+    "test08_sheet_with_hole_technique1_60.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test08_sheet_with_hole_technique1_400.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test08_sheet_with_hole_technique2_60.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test08_sheet_with_hole_technique2_400.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test08_sheet_with_hole_technique3_60.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test08_sheet_with_hole_technique3_400.toml": "no closed-form reference: tests/test_large_strain.py",
+    "test09_aorta_fast_M2.toml": "no static reference at this rate: test_fast_ramps_keep_energy_and_volume",
+    "test09_aorta_slow_M2.toml": "through the command line, its references checked by the exit code (tests/test_output.py)",
+    "test10_carotid_fast_M2.toml": "no static reference at this rate: test_fast_ramps_keep_energy_and_volume",
+}
 
 
-@pytest.mark.parametrize("name", DECKS)
-def test_deck_meets_its_references(name):
-    deck = load_deck(ROOT / "decks" / "verification" / name)
+def run_variant(name: str, overrides: dict):
+    path = VERIFICATION / name
+    data = apply_overrides(tomllib.loads(path.read_text(encoding="utf-8")), overrides, name)
+    deck = deck_from_data(data, name, path.parent)
     mesh = build_mesh(deck)
-    run = integrate(prepare(deck, mesh, build_model(deck, mesh)))
+    return integrate(prepare(deck, mesh, build_model(deck, mesh)))
+
+
+def test_every_verification_deck_is_run_or_accounted_for():
+    shipped = {p.name for p in VERIFICATION.glob("*.toml")}
+    assert not set(RUN) & set(ELSEWHERE)
+    assert shipped == set(RUN) | set(ELSEWHERE)
+
+
+@pytest.mark.parametrize("name", RUN)
+def test_deck_meets_its_references(name):
+    run = run_variant(name, RUN[name])
+    assert run.status == "completed"
     times = np.asarray(run.times)
-    results = [check(ref, times, np.asarray(run.history[ref.probe])) for ref in deck.reference]
+    reached = [ref for ref in run.deck.reference if ref.measure != "at_time" or ref.time <= times[-1]]
+    assert len(reached) >= min(3, len(run.deck.reference))
+    results = [check(ref, times, np.asarray(run.history[ref.probe])) for ref in reached]
     failed = [r for r in results if not r["passed"]]
     assert not failed, failed
+
+
+@pytest.mark.parametrize("name", ["test09_aorta_fast_M2.toml", "test10_carotid_fast_M2.toml"])
+def test_fast_ramps_keep_energy_and_volume(name):
+    """The fast ramps overshoot the static curve, so they have no reference; the wall is
+    incompressible and undamped: the volume changes by less than the 0.8% the thesis
+    reports on Test 9 (-0.3% on Test 10) and the energy balances within 0.1% of the
+    external work."""
+    run = run_variant(name, {})
+    assert run.status == "completed"
+    assert abs(run.sim.volume() / run.sim.volume(initial=True) - 1.0) < 0.008
+    assert abs(run.balance_error) < 1e-3 * run.sim.state.energy[EXTERNAL]

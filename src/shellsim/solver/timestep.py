@@ -14,6 +14,11 @@ from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
 from ..element import kernels
 
+#: Lanczos basis size. Warm-started from the last estimate's eigenvector, the estimate
+#: converges within its first basis, so ARPACK's default of 20 vectors spends three times
+#: the stiffness products (measured: 7 against 21 per estimate, the same bound to 3e-5).
+LANCZOS_VECTORS = 6
+
 
 def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.ndarray]:
     """Upper estimate of lambda_max = omega_max^2 at the simulation's current state, and the
@@ -38,7 +43,8 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
     operator = LinearOperator((size, size), matvec=apply, dtype=float)
     v0 = start if start is not None else np.random.default_rng(0).standard_normal(size)
     try:
-        values, vectors = eigsh(operator, k=1, which="LA", v0=v0, tol=1e-4, maxiter=2000)
+        values, vectors = eigsh(operator, k=1, which="LA", v0=v0, ncv=min(LANCZOS_VECTORS, size), tol=1e-4,
+                                maxiter=2000)
     except ArpackNoConvergence as partial:  # keep the best Ritz pair found
         values, vectors = partial.eigenvalues, partial.eigenvectors
     theta, vector = float(values[0]), vectors[:, 0]

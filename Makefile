@@ -23,9 +23,9 @@ run: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n auto
 
-# The slow tests (the stability suite among them), then the verification and stability
-# studies written into docs/verification/studies/ and their tables into
-# docs/verification.md (all committed).
+# The slow tests, then the verification and stability studies (the stability checks
+# live in the study: its exit code) written into docs/verification/studies/ and their
+# tables into docs/verification.md (all committed).
 verify: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
 	$(BIN)/shellsim report decks/studies/verification.toml --out docs/verification/studies/verification --embed docs/verification.md

@@ -4,6 +4,7 @@ streamed into report.md / report.csv / error_vs_time.png; a failed job is a row.
 from __future__ import annotations
 
 import csv
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -117,10 +118,26 @@ def test_external_points_need_their_columns(tmp_path):
         read_external(bad)
 
 
+#: A run's summary.json, the parts a report row reads.
+SUMMARY = {"status": "completed", "message": "", "dofs": 5, "elements": 1, "steps": 3,
+           "dt": {"mean": 1e-3, "min": 1e-3, "max": 3e-3}, "wall_time_s": 0.1, "us_per_element_step": 1.0,
+           "energy": {"balance_error_percent": 0.2}, "reference": []}
+
+
+def test_a_stability_run_is_judged_by_its_energy_balance_and_its_falling_step():
+    job = Job("f", "v", Path("d.toml"), {}, Path("out"), balance_within_percent=0.5, dt_falls_by=2.0)
+    good = row(job, SUMMARY)
+    assert good["passed"] is True and good["dt_fall"] == pytest.approx(3.0) and good["balance_error_percent"] == 0.2
+    leaky = row(job, SUMMARY | {"energy": {"balance_error_percent": -0.7}})
+    assert leaky["passed"] is False and "energy balance error -0.7% beyond 0.5%" in leaky["message"]
+    stiff = row(replace(job, dt_falls_by=4.0), SUMMARY)
+    assert stiff["passed"] is False and "fell 3 times, not 4.0" in stiff["message"]
+    assert row(replace(job, balance_within_percent=None, dt_falls_by=None), SUMMARY)["passed"] is None  # nothing checked
+
+
 def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
-    summary = {"status": "unstable", "message": "the run became unstable", "dofs": 5, "elements": 1, "steps": 3,
-               "dt": {"mean": 1e-3}, "wall_time_s": 0.1, "us_per_element_step": 1.0,
-               "reference": [{"passed": False, "error_percent": 98.0}]}
+    summary = SUMMARY | {"status": "unstable", "message": "the run became unstable",
+                         "reference": [{"passed": False, "error_percent": 98.0}]}
     on_purpose = row(Job("f", "v", Path("d.toml"), {}, Path("out"), expect="unstable"), summary)
     assert on_purpose["error_percent"] is None and on_purpose["passed"] is None and as_expected(on_purpose)
     by_accident = row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary)
@@ -130,8 +147,7 @@ def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
 
 
 def test_a_coarse_mesh_expected_to_miss_is_judged_by_missing():
-    summary = {"status": "completed", "message": "", "dofs": 5, "elements": 1, "steps": 3, "dt": {"mean": 1e-3},
-               "wall_time_s": 0.1, "us_per_element_step": 1.0, "reference": [{"passed": False, "error_percent": 3.8}]}
+    summary = SUMMARY | {"reference": [{"passed": False, "error_percent": 3.8}]}
     coarse = Job("f", "1x1", Path("d.toml"), {}, Path("out"), expect="missed")
     missed = row(coarse, summary)
     assert missed["error_percent"] == 3.8 and as_expected(missed)

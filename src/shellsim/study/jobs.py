@@ -15,7 +15,8 @@ from .schema import Study
 @dataclass(frozen=True)
 class Job:
     """deck: the deck file; overrides: dotted deck keys and their values; folder: where
-    the run writes; expect: the status the run should end with."""
+    the run writes; expect: how the run should end; balance_within_percent and
+    dt_falls_by: the study's checks beyond the references (None: not checked)."""
 
     family: str
     label: str
@@ -23,6 +24,8 @@ class Job:
     overrides: dict
     folder: Path
     expect: str = "completed"
+    balance_within_percent: float | None = None
+    dt_falls_by: float | None = None
 
     @property
     def key(self) -> str:
@@ -41,7 +44,8 @@ def study_jobs(study: Study, study_path: Path, out_dir: Path) -> list[Job]:
         family = entry.family or deck.stem
         for variant in entry.variant:
             folder = out_dir / "runs" / _slug(family) / _slug(variant.label)
-            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder, variant.expect))
+            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder, variant.expect,
+                            study.meta.balance_within_percent, entry.dt_falls_by))
     return jobs
 
 
@@ -78,25 +82,41 @@ def run_job(job: Job) -> dict:
 
 #: The columns of a report row, in order.
 COLUMNS = ("family", "variant", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
-           "us_per_element_step", "error_percent", "passed", "message", "folder")
+           "us_per_element_step", "error_percent", "balance_error_percent", "dt_fall", "passed", "message", "folder")
 
 
 def _identity(job: Job) -> dict:
     return {"family": job.family, "variant": job.label, "expected": job.expect, "folder": str(job.folder)}
 
 
+def _study_checks(job: Job, balance: float, fall: float) -> list[str]:
+    """What a completed run misses of the study's own checks, one phrase each."""
+    missed = []
+    if job.balance_within_percent is not None and not abs(balance) <= job.balance_within_percent:
+        missed.append(f"energy balance error {balance:.3g}% beyond {job.balance_within_percent}%")
+    if job.dt_falls_by is not None and not fall >= job.dt_falls_by:
+        missed.append(f"the time step fell {fall:.3g} times, not {job.dt_falls_by}")
+    return missed
+
+
 def row(job: Job, summary: dict) -> dict:
-    """The report's row of a finished run: size, steps, time and the worst reference error
-    (of a completed run: a run cut short is not measured against its references)."""
+    """The report's row of a finished run: size, steps, time, the worst reference error,
+    the energy balance error and how far the step fell (largest over smallest step); a
+    completed run passes when it meets its references and the study's checks (a run cut
+    short is not measured)."""
     completed = summary["status"] == "completed"
     errors = [abs(r["error_percent"]) for r in summary["reference"] if completed and r.get("error_percent") is not None]
+    balance = summary["energy"]["balance_error_percent"]
+    fall = summary["dt"]["max"] / summary["dt"]["min"] if summary["dt"]["min"] else None
+    missed = _study_checks(job, balance, fall) if completed else []
+    checked = bool(summary["reference"]) or job.balance_within_percent is not None or job.dt_falls_by is not None
+    passed = (all(r["passed"] for r in summary["reference"]) and not missed) if checked and completed else None
     return _identity(job) | {
         "status": summary["status"], "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
         "mean_dt": summary["dt"]["mean"], "wall_time_s": summary["wall_time_s"],
         "us_per_element_step": summary["us_per_element_step"],
-        "error_percent": max(errors) if errors else None,
-        "passed": all(r["passed"] for r in summary["reference"]) if summary["reference"] and completed else None,
-        "message": summary["message"] or "",
+        "error_percent": max(errors) if errors else None, "balance_error_percent": balance, "dt_fall": fall,
+        "passed": passed, "message": "; ".join(missed) or summary["message"] or "",
     }
 
 

@@ -52,9 +52,9 @@ def _cell(value) -> str:
 def table(rows: list[dict]) -> str:
     """The markdown table of ``rows``."""
     header = ("deck", "variant", "status", "DOFs", "steps", "mean dt", "wall time [s]", "us/element-step",
-              "error [%]", "passed", "note")
+              "error [%]", "balance [%]", "dt max/min", "passed", "note")
     keys = ("family", "variant", "status", "dofs", "steps", "mean_dt", "wall_time_s", "us_per_element_step",
-            "error_percent", "passed", "message")
+            "error_percent", "balance_error_percent", "dt_fall", "passed", "message")
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
         shown = r | {"status": r["status"] + ("" if as_expected(r) else f" (expected {r['expected']})")}

@@ -19,6 +19,10 @@ other programs to draw beside ours.
 
     [external]
     path = "peers.csv"                    # columns: family, program, label, error_percent, wall_time_s
+
+Checks beyond the decks' references, for stability studies: ``meta.balance_within_percent``
+bounds every completed run's energy balance error, and a deck's ``dt_falls_by`` asks its
+time step to shrink at least that many times over the run (a stiffening scene).
 """
 
 from __future__ import annotations
@@ -36,9 +40,13 @@ Text = Annotated[str, Field(strict=True, min_length=1)]
 Value = bool | int | float | str | list
 
 
+Positive = Annotated[float, Field(strict=False, gt=0.0)]
+
+
 class StudyMeta(Section):
     title: Text
     description: str = ""
+    balance_within_percent: Positive | None = None
 
 
 class Variant(Section):
@@ -57,6 +65,7 @@ class StudyDeck(Section):
 
     path: Text
     family: str = ""
+    dt_falls_by: Positive | None = None
     variant: list[Variant] = [Variant(label="as is")]
 
     @model_validator(mode="after")

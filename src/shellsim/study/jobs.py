@@ -89,6 +89,26 @@ def _identity(job: Job) -> dict:
     return {"family": job.family, "variant": job.label, "expected": job.expect, "folder": str(job.folder)}
 
 
+def _reference_errors(references: list[dict]) -> list[float | None]:
+    """Each reference check's error in percent: of its expected value when its tolerance
+    is relative; when it is absolute (a history that passes through zero, like a tip that
+    swings back), of the largest expected value checked on the same probe, since an error
+    relative to a value near zero says nothing. None where neither is defined."""
+    largest: dict[str, float] = {}
+    for r in references:
+        largest[r.get("probe")] = max(largest.get(r.get("probe"), 0.0), abs(r["expected"]))
+    errors = []
+    for r in references:
+        if r.get("error") is None:
+            errors.append(None)
+        elif r.get("tolerance") is None:
+            errors.append(None if r.get("error_percent") is None else abs(r["error_percent"]))
+        else:
+            scale = largest[r.get("probe")]
+            errors.append(100.0 * abs(r["error"]) / scale if scale else None)
+    return errors
+
+
 def _study_checks(job: Job, balance: float, fall: float) -> list[str]:
     """What a completed run misses of the study's own checks, one phrase each."""
     missed = []
@@ -105,7 +125,7 @@ def row(job: Job, summary: dict) -> dict:
     completed run passes when it meets its references and the study's checks (a run cut
     short is not measured)."""
     completed = summary["status"] == "completed"
-    errors = [abs(r["error_percent"]) for r in summary["reference"] if completed and r.get("error_percent") is not None]
+    errors = [e for e in _reference_errors(summary["reference"]) if e is not None] if completed else []
     balance = summary["energy"]["balance_error_percent"]
     fall = summary["dt"]["max"] / summary["dt"]["min"] if summary["dt"]["min"] else None
     missed = _study_checks(job, balance, fall) if completed else []

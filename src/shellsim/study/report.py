@@ -67,7 +67,9 @@ def table(rows: list[dict]) -> str:
 def markdown(title: str, rows: list[dict], pending: int) -> str:
     """report.md: the title, what the columns mean, how many jobs are still running, the table."""
     lines = [f"# {title}", "", "Error: the largest relative error over the deck's references (closed-form or "
-             "literature values cited in each deck). Wall time: the whole run, one process per job.", ""]
+             "literature values cited in each deck); a check with an absolute tolerance counts its error against "
+             "the largest value checked on its probe. Balance: the energy balance error, percent of the largest "
+             "energy. Wall time: the whole run, one process per job.", ""]
     if pending:
         lines += [f"*{pending} job(s) still running.*", ""]
     return "\n".join(lines) + "\n" + table(rows)
@@ -109,16 +111,19 @@ def csv_text(rows: list[dict]) -> str:
 def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> bytes:
     """Log-log error against wall time: one line per family in ladder order, each point
     labelled with its variant; other programs' points as open markers."""
+    from matplotlib import colormaps
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=(8.5, 6.5), layout="constrained")
     ax = figure.subplots()
     families = list(dict.fromkeys(r["family"] for r in rows))
-    for family in families:
+    colours = colormaps["tab20"].colors  # 20 colours and 7 markers: no two families look alike
+    for index, family in enumerate(families):
         done = [r for r in rows if r["family"] == family and r["error_percent"] and r["wall_time_s"]]
         if not done:
             continue
-        line, = ax.plot([r["wall_time_s"] for r in done], [r["error_percent"] for r in done], "o-", label=family)
+        line, = ax.plot([r["wall_time_s"] for r in done], [r["error_percent"] for r in done], "-",
+                        marker="os^Dv<>"[index % 7], color=colours[index % len(colours)], label=family)
         for r in done:
             ax.annotate(r["variant"], (r["wall_time_s"], r["error_percent"]), textcoords="offset points",
                         xytext=(4, 4), fontsize="x-small", color=line.get_color())

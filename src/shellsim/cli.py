@@ -80,7 +80,8 @@ def check(deck: DeckPath) -> None:
 
     scene = load_deck(deck)
     mesh = build_mesh(scene, deck.parent)
-    outlook = step_outlook(scene, build_model(scene, mesh))
+    with err.status("estimating the critical time step (the first use compiles the kernels, about a minute)"):
+        outlook = step_outlook(scene, build_model(scene, mesh))
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(

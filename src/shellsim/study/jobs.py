@@ -127,7 +127,7 @@ def row(job: Job, summary: dict) -> dict:
     completed = summary["status"] == "completed"
     errors = [e for e in _reference_errors(summary["reference"]) if e is not None] if completed else []
     balance = summary["energy"]["balance_error_percent"]
-    fall = summary["dt"]["max"] / summary["dt"]["min"] if summary["dt"]["min"] else None
+    fall = summary["dt"]["max"] / summary["dt"]["min"]
     missed = _study_checks(job, balance, fall) if completed else []
     checked = bool(summary["reference"]) or job.balance_within_percent is not None or job.dt_falls_by is not None
     passed = (all(r["passed"] for r in summary["reference"]) and not missed) if checked and completed else None

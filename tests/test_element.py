@@ -10,7 +10,7 @@ import pytest
 from shellsim.deck import parse_deck
 from shellsim.element import kernels
 from shellsim.element.frames import rotate_director
-from shellsim.element.sampling import nearest_integration_point, point_tensors
+from shellsim.element.sampling import point_tensors
 from shellsim.geometry import build_mesh
 from shellsim.mesh import Mesh, averaged_directors
 from shellsim.model import build_model

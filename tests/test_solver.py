@@ -11,7 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from shellsim.cli import app
-from shellsim.deck import load_deck, parse_deck
+from shellsim.deck import parse_deck
 from shellsim.deck.schema import Reference
 from shellsim.errors import NumericalError
 from shellsim.geometry import build_mesh

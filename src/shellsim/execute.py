@@ -12,13 +12,6 @@ from .errors import NumericalError, OutputError
 from .solver.run import Listener, Listeners, Run, Timed
 
 
-def _write_text(path: Path, text: str) -> None:
-    try:
-        path.write_text(text, encoding="utf-8")
-    except OSError as error:
-        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
-
-
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
     (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
@@ -28,6 +21,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .deck.resolved import resolved_text
     from .geometry import build_mesh
     from .model import build_model
+    from .output.folder import write_atomically
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
     from .output.summary import summary, write_json
@@ -36,7 +30,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
 
     mesh = build_mesh(scene, deck_path.parent)
     current = prepare(scene, mesh, build_model(scene, mesh))
-    _write_text(folder / "deck.toml", resolved_text(scene, deck_path, __version__))
+    write_atomically(folder / "deck.toml", resolved_text(scene, deck_path, __version__))
     message = None
     with ExitStack() as files:
         history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))

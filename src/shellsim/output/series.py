@@ -10,7 +10,6 @@ only on close.
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -21,15 +20,9 @@ from ..deck.schema import Output
 from ..errors import OutputError
 from ..solver.run import Listener, Run
 from .fields import OutputMesh, frame_fields, output_mesh
+from .folder import write_atomically
 
 XDMF_NAME, PVD_NAME, FRAMES_DIR = "results.xdmf", "results.pvd", "frames"
-
-
-def _replace_atomically(path: Path, write) -> None:
-    """Call ``write(partial_path)`` and move the result over ``path``."""
-    partial = path.with_name(path.name + ".partial")
-    write(partial)
-    os.replace(partial, path)
 
 
 class XdmfSeries:
@@ -48,7 +41,7 @@ class XdmfSeries:
     def write(self, t: float, point_data: dict, cell_data: dict) -> None:
         self._writer.write_data(t, point_data, {name: [values] for name, values in cell_data.items()})
         self._writer.h5_file.flush()
-        _replace_atomically(self.path, lambda p: ET.ElementTree(self._writer.xdmf_file).write(p))
+        write_atomically(self.path, ET.tostring(self._writer.xdmf_file))
 
     def close(self) -> None:
         self._writer.h5_file.close()
@@ -78,7 +71,7 @@ class VtuSeries:
         collection = ET.SubElement(root, "Collection")
         for time, file in self.entries:
             ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
-        _replace_atomically(self.path, lambda p: ET.ElementTree(root).write(p, xml_declaration=True))
+        write_atomically(self.path, ET.tostring(root, xml_declaration=True))
 
     def close(self) -> None:
         pass

@@ -4,7 +4,6 @@ and left out, and each reference check."""
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +13,7 @@ from ..plan import Plan
 from ..solver.explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
 from ..solver.run import Run, dt_statistics
 from ..verify.check import check
+from .folder import write_atomically
 
 
 def reference_results(run: Run) -> list[dict]:
@@ -62,7 +62,5 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
 
 
 def write_json(data: dict, path: Path) -> None:
-    """Write ``data`` atomically (a reader never sees half a file)."""
-    partial = path.with_suffix(".json.partial")
-    partial.write_text(json.dumps(data, indent=2, allow_nan=True) + "\n", encoding="utf-8")
-    os.replace(partial, path)
+    """Write ``data`` as JSON, atomically."""
+    write_atomically(path, json.dumps(data, indent=2, allow_nan=True) + "\n")

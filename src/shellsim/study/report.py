@@ -8,19 +8,13 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 from pathlib import Path
 
 from ..errors import DeckError, OutputError
+from ..output.folder import write_atomically
 from .jobs import COLUMNS, as_expected
 
 EXTERNAL_COLUMNS = ("family", "program", "label", "error_percent", "wall_time_s")
-
-
-def _replace(path: Path, data: str | bytes) -> None:
-    partial = path.with_name(path.name + ".partial")
-    partial.write_bytes(data if isinstance(data, bytes) else data.encode("utf-8"))
-    os.replace(partial, path)
 
 
 def read_external(path: Path) -> list[dict]:
@@ -97,7 +91,7 @@ def embed_span(document: Path, key: str) -> tuple[str, int, int]:
 def embed(document: Path, key: str, rows: list[dict]) -> None:
     """Replace the span between ``document``'s markers for ``key`` with the table of ``rows``."""
     text, start, stop = embed_span(document, key)
-    _replace(document, text[:start] + "\n" + table(rows) + text[stop:])
+    write_atomically(document, text[:start] + "\n" + table(rows) + text[stop:])
 
 
 def csv_text(rows: list[dict]) -> str:
@@ -150,6 +144,6 @@ def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> byt
 
 def write_report(out_dir: Path, title: str, rows: list[dict], pending: int, external: list[dict]) -> None:
     """report.md, report.csv and error_vs_time.png in ``out_dir`` for the rows so far."""
-    _replace(out_dir / "report.md", markdown(title, rows, pending))
-    _replace(out_dir / "report.csv", csv_text(rows))
-    _replace(out_dir / "error_vs_time.png", error_vs_time_png(title, rows, external))
+    write_atomically(out_dir / "report.md", markdown(title, rows, pending))
+    write_atomically(out_dir / "report.csv", csv_text(rows))
+    write_atomically(out_dir / "error_vs_time.png", error_vs_time_png(title, rows, external))

@@ -18,7 +18,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     and summary.json whatever the end. Returns (run, summary); ``run.status`` tells how it
     ended ('completed', 'unstable', 'interrupted', 'output failed') and the summary's
     ``message`` why. Renders are left to the caller."""
-    from .deck.resolved import resolved_text
+    from .deck.resolved import RESOLVED_NAME, resolved_text
     from .geometry import build_mesh
     from .model import build_model
     from .output.folder import write_atomically
@@ -30,7 +30,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
 
     mesh = build_mesh(scene, deck_path.parent)
     current = prepare(scene, mesh, build_model(scene, mesh))
-    write_atomically(folder / "deck.toml", resolved_text(scene, deck_path, __version__))
+    write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
     message = None
     with ExitStack() as files:
         history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))

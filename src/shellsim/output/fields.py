@@ -49,12 +49,13 @@ CORNER_N = shape(CORNER_RS)
 SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in range(3) for i in range(3))])
 
 
-def unit(field: str, system: str) -> str:
-    """The unit of ``field`` (a field or probe quantity, possibly with the nodal suffix, or
-    a kind: length, stress, time) in ``system``; '-' when it has none."""
+def labelled(text: str, field: str, system: str) -> str:
+    """``text`` with the unit of ``field`` (a field or probe quantity, possibly with the
+    nodal suffix, or a kind: length, stress, time) in the unit ``system`` in brackets, when
+    the system names one."""
     name = field.removesuffix(NODAL_SUFFIX)
-    kind = FIELD_KIND.get(name, name if name in ("length", "stress", "time") else None)
-    return UNITS.get(system, {}).get(kind, "") if kind else "-"
+    unit = UNITS.get(system, {}).get(FIELD_KIND.get(name, name), "")
+    return f"{text} ({unit})" if unit else text
 
 
 @dataclass(frozen=True)

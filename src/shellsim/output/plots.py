@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..deck import parse_deck
+from ..deck.resolved import read_resolved
 from ..errors import OutputError
+from .fields import labelled
 from .folder import output_folder
-from .fields import unit
 
 PLOTS_DIR = "plots"
 #: How each reference measure is drawn: as points on the curve, or as a level.
@@ -22,8 +22,8 @@ LEVEL_MEASURES = ("max", "min", "max_abs")
 
 def _read(folder: Path) -> tuple[object, np.ndarray]:
     """(resolved deck, history table with named columns) of a results folder."""
+    deck = read_resolved(folder)
     try:
-        deck = parse_deck((folder / "deck.toml").read_text(encoding="utf-8"), name=str(folder / "deck.toml"))
         history = np.genfromtxt(folder / "history.csv", delimiter=",", names=True, ndmin=1)
     except OSError as error:
         raise OutputError(f"'{folder}' is not a finished run's folder: {error.strerror or error} "
@@ -39,7 +39,7 @@ def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
         if getattr(load, "curve", None) and np.ndim(load.value) == 0:
             kind = "stress" if load.type in ("pressure", "edge_pressure") else "load"
             label = f"{load.type.replace('_', ' ')} on '{load.set}'"
-            return load.value * deck.curves[load.curve](times), _labelled(label, unit(kind, deck.meta.units))
+            return load.value * deck.curves[load.curve](times), labelled(label, kind, deck.meta.units)
     return None
 
 
@@ -57,10 +57,9 @@ def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float
         values = history[probe.name]
         figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")
         axes = figure.subplots(1, 2 if load else 1, squeeze=False)[0]
-        units = unit(probe.quantity, deck.meta.units)
-        ylabel = _labelled(probe.name, units)
+        ylabel = labelled(probe.name, probe.quantity, deck.meta.units)
         for ax, x, xlabel in zip(axes, (times, *(load[:1] if load else ())),
-                                 (_labelled("time", unit("time", deck.meta.units)), *(load[1:] if load else ()))):
+                                 (labelled("time", "time", deck.meta.units), *(load[1:] if load else ()))):
             ax.plot(x, values, color="black", lw=1.4, label="shellsim")
             _draw_references(ax, deck, probe.name, times, x)
             ax.set_xlabel(xlabel)
@@ -93,10 +92,6 @@ def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray) -> 
                 ax.axvline(r.expected, color=colour, ls="--", lw=1, label=_short(label))
 
 
-def _labelled(name: str, units: str) -> str:
-    return name + (f" ({units})" if units not in ("-", "") else "")
-
-
 def _tolerance(reference) -> float:
     """The reference's tolerance band half-width, in the quantity's units."""
     if reference.tolerance is not None:
@@ -119,7 +114,7 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
         ax.plot(t, history[column], ls=style, label=label)
     balance = history["internal_energy"] + history["kinetic_energy"] + history["damping_work"] - history["external_work"]
     ax.plot(t, balance, color="black", ls=":", label="balance (internal + kinetic + damping - external)")
-    ax.set_xlabel(_labelled("time", unit("time", deck.meta.units)))
+    ax.set_xlabel(labelled("time", "time", deck.meta.units))
     ax.set_ylabel("energy")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from ..element.shape import shape
-from ..errors import OutputError
+from ..errors import OutputError, ShellsimError
 from .folder import output_folder
 from ..mesh import Mesh
 
@@ -131,13 +131,13 @@ def field_values(point_data: dict, cell_data: dict, field: str, component: str |
 
 def _series_units(folder: Path) -> tuple[str, str]:
     """(title, unit system) of the deck a results folder was run from, if it is there."""
-    import tomllib
+    from ..deck.resolved import read_resolved
 
     try:
-        meta = tomllib.loads((folder / "deck.toml").read_text(encoding="utf-8")).get("meta", {})
-    except (OSError, tomllib.TOMLDecodeError):
+        meta = read_resolved(folder).meta
+    except ShellsimError:  # a series without its deck is still drawn, without units
         return "", "consistent"
-    return meta.get("title", ""), meta.get("units", "consistent")
+    return meta.title, meta.units
 
 
 def _frame_indices(frame: str | int, count: int) -> list[int]:
@@ -157,7 +157,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     """PNGs of ``field`` on the deformed shape for the chosen frames of the series in
     ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
     to ``out_dir`` (default ``folder/renders``). Returns the files written."""
-    from .fields import NODAL_SUFFIX, unit
+    from .fields import NODAL_SUFFIX, labelled
     from .series import StoredSeries
 
     series = StoredSeries(folder)
@@ -170,7 +170,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
     title, units = _series_units(folder)
     label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
-    bar = f"{label} {picked[0][2]}".strip() + (f" ({unit(field, units)})" if unit(field, units) not in ("-", "") else "")
+    bar = labelled(f"{label} {picked[0][2]}".strip(), field, units)
     out_dir = output_folder(out_dir or folder / RENDERS_DIR)
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []

@@ -19,6 +19,17 @@ def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndar
     return divmod(flat, len(N_gauss))
 
 
+def thickness_mean(values: np.ndarray, wt: np.ndarray, axis: int) -> np.ndarray:
+    """The weighted mean of point ``values`` over the thickness layers on ``axis``, with the
+    thickness rule's weights ``wt`` (nt,); that axis is removed."""
+    return np.tensordot(wt / wt.sum(), values, axes=([0], [axis]))
+
+
+def pressure_band(sigma: np.ndarray) -> np.ndarray:
+    """-trace(sigma) / 3 of each (..., 3, 3) stress: the thesis' pressure band."""
+    return -np.trace(sigma, axis1=-2, axis2=-1) / 3.0
+
+
 @njit(cache=True)
 def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauchy, green):
     """Tensors at every integration point (element e, in-plane point q, layer k).

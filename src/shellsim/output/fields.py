@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import gauss_rule, shape
 from ..model import Model
 from ..solver.simulation import Simulation
@@ -119,7 +120,7 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
         return {}  # no stress or strain asked for: nothing to sample
     lamina, cauchy, green = sim.point_tensors()
     values = {"cauchy_stress": cauchy, "lamina_stress": lamina, "green_lagrange_strain": green,
-              "pressure_band": -np.trace(cauchy, axis1=-2, axis2=-1) / 3.0}
+              "pressure_band": pressure_band(cauchy)}
     if "von_mises" in fields:
         values["von_mises"] = von_mises(cauchy)
     return {name: values[name] for name in fields if name in CELL_FIELDS}
@@ -157,13 +158,12 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
     if "thickness" in fields:
         point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
     cell_data: dict[str, np.ndarray] = {}
-    weights = model.wt / model.wt.sum()
     for name, values in _point_values(sim, fields).items():
         flat = values.reshape(*values.shape[:3], -1)  # (ne, nq, nt, 1 or 9)
         if mesh.solid:
             cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
         else:
-            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else np.einsum("k,eqkc->eqc", weights, flat)
+            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, through))
     return point_data, cell_data

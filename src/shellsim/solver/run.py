@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..deck import Deck
-from ..element.sampling import nearest_integration_point
+from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
 from ..errors import NumericalError
 from ..mesh import Mesh
 from ..model import FACES, Model
@@ -140,9 +140,9 @@ def probe_value(run: Run, probe: Probe) -> float:
     if probe.quantity in POINT_QUANTITIES:
         e, p = probe.element, probe.point
         _, cauchy, green = run.sim.point_tensors(slice(e, e + 1), slice(p, p + 1))
-        tensor = np.einsum("k,kij->ij", m.wt / m.wt.sum(), (green if probe.quantity == "strain" else cauchy)[0, 0])
+        tensor = thickness_mean((green if probe.quantity == "strain" else cauchy)[0, 0], m.wt, axis=0)
         if probe.quantity == "pressure_band":
-            return float(-np.trace(tensor) / 3.0)
+            return float(pressure_band(tensor))
         return float(tensor[TENSOR_COMPONENTS[probe.component]])
     if probe.quantity == "thickness":
         return float(s.h[nodes].mean())

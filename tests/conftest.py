@@ -42,6 +42,23 @@ def pytest_configure(config):
         warm_numba_cache()
 
 
+def prepared(deck):
+    """A run of ``deck`` ready to start: mesh, model and simulation built."""
+    from shellsim.geometry import build_mesh
+    from shellsim.model import build_model
+    from shellsim.solver.run import prepare
+
+    mesh = build_mesh(deck)
+    return prepare(deck, mesh, build_model(deck, mesh))
+
+
+def run_deck(deck):
+    """``deck`` run to its end time."""
+    from shellsim.solver.run import integrate
+
+    return integrate(prepared(deck))
+
+
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     """A valid deck: ``base`` + [geometry] body + extra tables."""
     return f"{base}\n[geometry]\n{geometry}\n{extra}"

@@ -5,30 +5,25 @@ the three techniques, which share their small-strain limit, must agree."""
 
 from __future__ import annotations
 
-import tomllib
-
 import numpy as np
 import pytest
 
-from shellsim.deck import deck_from_data, load_deck
-from shellsim.geometry import build_mesh
-from shellsim.model import build_model
 from shellsim.solver.explicit import EXTERNAL
-from shellsim.solver.run import integrate, prepare
+from shellsim.study.jobs import variant_deck
 
-from .conftest import ROOT
+from .conftest import ROOT, run_deck
+
+VERIFICATION = ROOT / "decks" / "verification"
 
 
-def run_deck(name: str):
-    deck = load_deck(ROOT / "decks" / "verification" / name)
-    mesh = build_mesh(deck)
-    return integrate(prepare(deck, mesh, build_model(deck, mesh)))
+def run_verification_deck(name: str, overrides: dict | None = None):
+    return run_deck(variant_deck(VERIFICATION / name, overrides or {}))
 
 
 @pytest.mark.parametrize("technique", [1, 2, 3])
 @pytest.mark.parametrize("steps", [60, 400])
 def test_holed_sheet_reaches_the_final_load(technique, steps):
-    run = run_deck(f"test08_sheet_with_hole_technique{technique}_{steps}.toml")
+    run = run_verification_deck(f"test08_sheet_with_hole_technique{technique}_{steps}.toml")
     assert run.status == "completed"
     assert run.sim.state.t == pytest.approx(run.deck.solver.end_time)
     assert abs(run.balance_error) < 0.01 * run.sim.state.energy[EXTERNAL]
@@ -44,7 +39,7 @@ def test_techniques_agree_at_small_load():
     carries half the load, on the same ramp time) within 2%."""
     values = []
     for technique, scale in ((1, 1.0), (2, 1.0), (3, 2.0)):
-        run = run_deck(f"test08_sheet_with_hole_technique{technique}_400.toml")
+        run = run_verification_deck(f"test08_sheet_with_hole_technique{technique}_400.toml")
         ramp = run.deck.curves["ramp"].t[-1]
         values.append(scale * np.interp(0.05 * ramp, run.times, run.history["uA"]))
     assert max(values) == pytest.approx(min(values), rel=0.02), values
@@ -62,11 +57,7 @@ def test_inflated_tube_meets_the_exact_resultants(name, pressure):
     lamina) being xx + yy there. On the decks' 2 x 8 mesh the hoop resultant read this way
     is 6.3% (Test 9) and 7.2% (Test 10) short, on 4 x 16 1.7% and 1.4%: the stresses of the
     45-degree curved elements converge to it, as a linear elastic tube's do (4.5%, 1.6%)."""
-    data = tomllib.loads((ROOT / "decks" / "verification" / name).read_text())
-    data["mesh"]["divisions"] = {"around": 4, "axial": 16}
-    deck = deck_from_data(data)
-    mesh = build_mesh(deck)
-    run = integrate(prepare(deck, mesh, build_model(deck, mesh)))
+    run = run_verification_deck(name, {"mesh.divisions": {"around": 4, "axial": 16}})
     final = {key: values[-1] for key, values in run.history.items()}
     r_i, h = final["inner_radius"], final["wall_thickness"]
     r_mid = r_i + 0.5 * h

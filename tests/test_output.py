@@ -21,13 +21,11 @@ from typer.testing import CliRunner
 from shellsim.cli import app
 from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import OutputError
-from shellsim.geometry import build_mesh
-from shellsim.model import build_model
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
 from shellsim.output.series import check_space
-from shellsim.solver.run import output_times, prepare
+from shellsim.solver.run import output_times
 
-from .conftest import ROOT, deck_text
+from .conftest import ROOT, deck_text, prepared
 
 runner = CliRunner()
 ALL_FIELDS = ["displacement", "director", "thickness", "cauchy_stress", "lamina_stress", "pressure_band",
@@ -130,8 +128,7 @@ def _plate_simulation(displacement, director=None):
     """A 2 x 2 flat plate with its mid-surface moved by ``displacement(x0)`` (n, 3) and
     its directors set to ``director(x0)`` (n, 3) if given."""
     deck = parse_deck(PLATE)
-    mesh = build_mesh(deck)
-    run = prepare(deck, mesh, build_model(deck, mesh))
+    run = prepared(deck)
     run.sim.state.x[:] = run.model.x0 + displacement(run.model.x0)
     if director is not None:
         d = director(run.model.x0)

@@ -14,20 +14,13 @@ from shellsim.cli import app
 from shellsim.deck import parse_deck
 from shellsim.deck.schema import Reference
 from shellsim.errors import NumericalError
-from shellsim.geometry import build_mesh
-from shellsim.model import build_model
 from shellsim.solver.explicit import EXTERNAL
-from shellsim.solver.run import integrate, prepare
+from shellsim.study.jobs import variant_deck
 from shellsim.verify.check import check, first_peak
 
-from .conftest import ROOT
+from .conftest import ROOT, prepared, run_deck
 
 PLATE = ROOT / "decks" / "verification" / "test01_plate_step_2x2.toml"
-
-
-def run_deck(deck):
-    mesh = build_mesh(deck)
-    return integrate(prepare(deck, mesh, build_model(deck, mesh)))
 
 
 @pytest.fixture(scope="module", params=["total", "incremental"])
@@ -59,20 +52,18 @@ def test_the_critical_step_is_refreshed_on_schedule(plate_run):
     assert all(dt < crit for _, crit, dt in plate_run.dt_history)
 
 
-def critical_step(text: str, thickness: float, mass: str) -> float:
-    deck = parse_deck(text.replace("thickness = 1.0", f"thickness = {thickness}", 1)
-                      .replace("[solver]\n", f'[solver]\nmass = "{mass}"\n', 1))
-    mesh = build_mesh(deck)
-    return prepare(deck, mesh, build_model(deck, mesh)).sim.critical_time_step()
+def critical_step(thickness: float, mass: str) -> float:
+    deck = variant_deck(ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3.toml",
+                        {"section.thickness": thickness, "solver.mass": mass})
+    return prepared(deck).sim.critical_time_step()
 
 
 def test_m1_rotary_inertia_keeps_the_step_of_a_thin_shell():
     """M2's rotary inertia rho h^3 / 12 against the shear stiffness kappa G h makes the
     critical step fall with the thickness (t/L from 1e-3 to 1e-4: ten times); M1's floor
     A / 8 per unit mass (thesis 3.14.1) keeps it at the membrane's, whatever the thickness."""
-    text = (ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3.toml").read_text()
-    m2 = critical_step(text, 0.01, "M2") / critical_step(text, 0.001, "M2")
-    m1 = critical_step(text, 0.01, "M1") / critical_step(text, 0.001, "M1")
+    m2 = critical_step(0.01, "M2") / critical_step(0.001, "M2")
+    m1 = critical_step(0.01, "M1") / critical_step(0.001, "M1")
     assert m2 == pytest.approx(10.0, rel=0.05)
     assert m1 == pytest.approx(1.0, abs=1e-3)
 

@@ -6,20 +6,14 @@ complete, so a new deck cannot go unchecked."""
 
 from __future__ import annotations
 
-import tomllib
-
 import numpy as np
 import pytest
 
-from shellsim.deck import deck_from_data
-from shellsim.geometry import build_mesh
-from shellsim.model import build_model
 from shellsim.solver.explicit import EXTERNAL
-from shellsim.solver.run import integrate, prepare
-from shellsim.study.jobs import apply_overrides
+from shellsim.study.jobs import variant_deck
 from shellsim.verify.check import check
 
-from .conftest import ROOT
+from .conftest import ROOT, run_deck
 
 VERIFICATION = ROOT / "decks" / "verification"
 
@@ -67,11 +61,7 @@ ELSEWHERE = {
 
 
 def run_variant(name: str, overrides: dict):
-    path = VERIFICATION / name
-    data = apply_overrides(tomllib.loads(path.read_text(encoding="utf-8")), overrides, name)
-    deck = deck_from_data(data, name, path.parent)
-    mesh = build_mesh(deck)
-    return integrate(prepare(deck, mesh, build_model(deck, mesh)))
+    return run_deck(variant_deck(VERIFICATION / name, overrides))
 
 
 def test_every_verification_deck_is_run_or_accounted_for():

@@ -8,6 +8,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..deck import Deck
 from ..errors import DeckError
 from .schema import Study
 
@@ -67,15 +68,21 @@ def apply_overrides(data: dict, overrides: dict, name: str) -> dict:
     return data
 
 
+def variant_deck(path: Path, overrides: dict, label: str = "") -> Deck:
+    """The deck at ``path`` with ``overrides`` (dotted keys) applied, validated; named
+    ``path [label]`` in its messages. Raises DeckError on a broken deck or variant."""
+    from ..deck import deck_from_data
+
+    data = apply_overrides(tomllib.loads(path.read_text(encoding="utf-8")), overrides, str(path))
+    return deck_from_data(data, f"{path} [{label}]" if label else str(path), path.parent)
+
+
 def run_job(job: Job) -> dict:
     """Run one job; returns its report row (raises on a broken deck or variant)."""
-    from ..deck import deck_from_data
     from ..execute import run_scene
     from ..output.folder import output_folder
 
-    text = job.deck.read_text(encoding="utf-8")
-    data = apply_overrides(tomllib.loads(text), job.overrides, str(job.deck))
-    scene = deck_from_data(data, f"{job.deck} [{job.label}]", job.deck.parent)
+    scene = variant_deck(job.deck, job.overrides, job.label)
     _, summary = run_scene(scene, job.deck, output_folder(job.folder))
     return row(job, summary)
 

@@ -65,13 +65,17 @@ class OutputMesh:
 
     points (P, 3): initial positions, P = ne * L * 16; cells (C, 4) quads (shell) or (C, 8)
     hexahedra (solid), C = ne * 9 * nt for the solid, ne * 9 for the shell; layers (L,):
-    thickness coordinates of the corner layers ([0] for the shell).
+    thickness coordinates of the corner layers ([0] for the shell); gauss_to_nodes (9, 9):
+    the element's nodal values of the biquadratic through its 3 x 3 Gauss values;
+    elements_at_node (n,): how many elements share each node.
     """
 
     points: np.ndarray
     cells: np.ndarray
     cell_type: str
     layers: np.ndarray
+    gauss_to_nodes: np.ndarray
+    elements_at_node: np.ndarray
 
     @property
     def solid(self) -> bool:
@@ -105,7 +109,9 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
         local = SUB_QUADS
     cells = (np.arange(ne)[:, None, None] * len(layers) * 16 + local[None]).reshape(-1, local.shape[1])
     points = _corner_points(model.x0, model.d0, model.h0, model.conn, layers)
-    return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers)
+    return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers,
+                      gauss_to_nodes=np.linalg.inv(model.N[:len(model.wq)]),
+                      elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes))
 
 
 def von_mises(sigma: np.ndarray) -> np.ndarray:
@@ -126,16 +132,15 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
-def _smoothed(model: Model, cell_values: np.ndarray) -> np.ndarray:
+def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.ndarray:
     """Nodal version (ne * 16, ...) at the shell view's corners of per-point values
     (ne, 9, ...): the biquadratic through an element's 3 x 3 Gauss values, read at its
     nodes, averaged over the elements sharing each node, interpolated back to the corners."""
-    extrapolate = np.linalg.inv(model.N[:len(model.wq)])  # Gauss values -> node values
-    at_nodes = np.einsum("aq,eq...->ea...", extrapolate, cell_values)
+    at_nodes = np.einsum("aq,eq...->ea...", mesh.gauss_to_nodes, cell_values)
     total = np.zeros((model.n_nodes, *cell_values.shape[2:]))
     np.add.at(total, model.conn, at_nodes)
-    count = np.bincount(model.conn.ravel(), minlength=model.n_nodes)
-    return _at_corners(total / count.reshape(-1, *([1] * (total.ndim - 1))), model.conn, 1)
+    count = mesh.elements_at_node.reshape(-1, *([1] * (total.ndim - 1)))
+    return _at_corners(total / count, model.conn, 1)
 
 
 def _columns(values: np.ndarray) -> np.ndarray:
@@ -148,10 +153,9 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
     of shape (P,) or (P, 3) on the points, (C,) or (C, 9) on the cells; tensors are written
     row by row (xx, xy, xz, yx, ...), as ParaView reads a 9-component array."""
     model, state = sim.model, sim.state
-    points = _corner_points(state.x, state.d, state.h, model.conn, mesh.layers)
     point_data: dict[str, np.ndarray] = {}
     if "displacement" in fields:
-        point_data["displacement"] = points - mesh.points
+        point_data["displacement"] = _corner_points(state.x, state.d, state.h, model.conn, mesh.layers) - mesh.points
     if "director" in fields:
         director = _at_corners(state.d, model.conn, len(mesh.layers))
         point_data["director"] = director / np.linalg.norm(director, axis=1, keepdims=True)
@@ -165,5 +169,5 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
         else:
             through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
-            point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, through))
+            point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
     return point_data, cell_data

@@ -8,6 +8,9 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    # one test process per core already: a worker's kernels run on one thread each
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Scene decks shipped (studies, which name decks, live in decks/studies and are not decks).

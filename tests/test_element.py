@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
 from shellsim.element import kernels
 from shellsim.element.frames import rotate_director
@@ -71,11 +72,11 @@ def internal(model, x, d, e1, h=None, step=None, stress=None):
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     if stress is None:
-        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-    kernels.internal_forces(x, d, model.h0.copy() if h is None else h, e1, model.conn, model.N, model.dNr, model.dNs,
-                            model.tie, model.tie_points, model.wq, model.tz, model.wt, model.jac0_inv, model.C,
-                            model.vol_basis, model.material, step is not None, x * 0 if step is None else step, x * 0,
-                            stress, f, fr)
+        stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
+    shape = Shape(x=x, d=d, e1=e1, h=model.h0.copy() if h is None else h)
+    material = model.material._replace(incremental=step is not None)
+    kernels.internal_forces(model.rule, model.body, material, shape, x * 0 if step is None else step, x * 0, stress, f, fr,
+                            kernels.assembly(n, model.n_elements), kernels.element_chunks(model.n_elements))
     return f, fr, stress
 
 
@@ -85,11 +86,15 @@ def stiffness(model, vu, vr, x=None, stress=None):
     n = model.n_nodes
     f, fr = np.zeros((n, 3)), np.zeros((n, 2))
     if stress is None:
-        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
-    kernels.stiffness_product(model.x0 if x is None else x, model.d0, model.h0, model.e1f0, model.conn, model.N,
-                              model.dNr, model.dNs, model.tie, model.tie_points, model.wq, model.tz, model.wt,
-                              model.jac0_inv, model.C, model.vol_basis, model.material, stress, vu, vr, f, fr)
+        stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
+    shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
+    kernels.stiffness_product(model.rule, model.body, model.material, shape, stress, vu, vr, f, fr,
+                              kernels.element_chunks(model.n_elements))
     return f, fr
+
+
+def initial_shape(model) -> Shape:
+    return Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
 
 
 def moved(model, eps, vu, vr):
@@ -181,7 +186,7 @@ def membrane_patch(model):
 def uniform_plane_stress(model, stress):
     """The stress is the plane-stress law applied to STRAIN at every point (compared by the
     invariants of the in-plane stress: the lamina axes need not be x, y)."""
-    expected = model.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
+    expected = model.material.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     s11, s22, s12 = stress[..., 0], stress[..., 1], stress[..., 2]
     np.testing.assert_allclose(s11 + s22, expected[0] + expected[1], rtol=1e-5)
     np.testing.assert_allclose(s11 * s22 - s12**2, expected[0] * expected[1] - expected[2] ** 2, rtol=1e-5)
@@ -205,11 +210,11 @@ def test_point_tensors_are_the_plane_stress_law_and_the_exact_strain_in_global_a
     R = rotation(np.array([0.0, 0.0, 1.0]), turn)
     x, d = (model.x0 + model.x0 @ STRAIN.T) @ R.T, model.d0 @ R.T
     _, _, stress = internal(model, x, d, model.e1f0 @ R.T)
-    law = model.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
+    law = model.material.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     sigma = np.array([[law[0], law[2], 0.0], [law[2], law[1], 0.0], [0.0, 0.0, 0.0]])
-    out = [np.empty((model.n_elements, 9, len(model.tz), 3, 3)) for _ in range(3)]
-    point_tensors(x, d, model.h0, model.conn, model.N[:9], model.dNr[:9], model.dNs[:9], model.tz,
-                  model.jac0_inv, stress, *out)
+    out = [np.empty((model.n_elements, 9, len(model.rule.tz), 3, 3)) for _ in range(3)]
+    point_tensors(x, d, model.h0, model.conn, model.rule.N[:9], model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz,
+                  model.body.jac0_inv, stress, *out)
     lamina, cauchy, green = out
     np.testing.assert_allclose(cauchy, np.broadcast_to(R @ sigma @ R.T, cauchy.shape), atol=1e-6 * np.abs(law).max())
     F = np.eye(3) + STRAIN
@@ -222,10 +227,10 @@ def test_rigid_rotation_gives_zero_green_lagrange_strain_everywhere(curved):
     produces no Green-Lagrange strain at any integration point."""
     model = curved
     R = rotation(np.array([0.3, -0.5, 0.8]), 2.4)
-    out = [np.empty((model.n_elements, 9, len(model.tz), 3, 3)) for _ in range(3)]
-    point_tensors(model.x0 @ R.T + [1.0, -2.0, 3.0], model.d0 @ R.T, model.h0, model.conn, model.N[:9],
-                  model.dNr[:9], model.dNs[:9], model.tz, model.jac0_inv,
-                  np.zeros((model.n_elements, 9, len(model.tz), 5)), *out)
+    out = [np.empty((model.n_elements, 9, len(model.rule.tz), 3, 3)) for _ in range(3)]
+    point_tensors(model.x0 @ R.T + [1.0, -2.0, 3.0], model.d0 @ R.T, model.h0, model.conn, model.rule.N[:9],
+                  model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz, model.body.jac0_inv,
+                  np.zeros((model.n_elements, 9, len(model.rule.tz), 5)), *out)
     assert np.abs(out[2]).max() < 1e-12
 
 
@@ -272,9 +277,8 @@ def test_lumped_masses_add_up_and_are_positive(curved, mass):
     model = curved
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    kernels.lumped_masses(model.x0, model.d0, model.h0, model.conn, model.N, model.dNr, model.dNs, model.wq,
-                          model.tz, model.wt, 7.0, mass == "M1", mt, mr)
-    volume = np.sum(1.0 / np.abs(np.linalg.det(model.jac0_inv[:, :9])) * model.wq[None, :, None] * model.wt[None, None, :])
+    kernels.lumped_masses(model.rule, model.body, initial_shape(model), 7.0, mass == "M1", mt, mr)
+    volume = np.sum(1.0 / np.abs(np.linalg.det(model.body.jac0_inv[:, :9])) * model.rule.wq[None, :, None] * model.rule.wt[None, None, :])
     assert mt.sum() == pytest.approx(7.0 * volume, rel=1e-12)
     assert np.all(mt > 0) and np.all(mr > 0)
 
@@ -283,8 +287,7 @@ def test_m2_masses_of_a_rectangle_are_the_tensor_product_of_simpson_weights():
     _, model = make_model('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "divisions = { length = 1, width = 1 }")
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    kernels.lumped_masses(model.x0, model.d0, model.h0, model.conn, model.N, model.dNr, model.dNs, model.wq,
-                          model.tz, model.wt, 1.0, False, mt, mr)
+    kernels.lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
     total = 2.0 * 1.0 * T
     np.testing.assert_allclose(mt[model.conn[0]], total * np.array([1, 1, 1, 1, 4, 4, 4, 4, 16]) / 36, rtol=1e-12)
     np.testing.assert_allclose(mr / mt, T**2 / 12, rtol=1e-12)  # director inertia of the fibre
@@ -383,7 +386,7 @@ def test_constant_tensor_techniques_follow_their_exact_homogeneous_response(tech
     }
     for case, lateral, normal in (("uniaxial", -nu, -nu), ("equibiaxial", 1.0, -2 * nu / (1 - nu))):
         h = model.h0.copy()
-        stress = np.zeros((model.n_elements, len(model.wq), len(model.tz), 5))
+        stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
         previous = model.x0.copy()
         for x in np.linspace(0.0, x_end, steps + 1)[1:]:
             current = model.x0 * [np.exp(x), np.exp(lateral * x), 1.0]
@@ -426,8 +429,7 @@ def test_m2_rotary_inertia_does_not_depend_on_the_thickness_rule():
                               material=('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
                                         f"points_through_thickness = {points}"))
         mt, mr = np.empty(model.n_nodes), np.empty(model.n_nodes)
-        kernels.lumped_masses(model.x0, model.d0, model.h0, model.conn, model.N, model.dNr, model.dNs, model.wq,
-                              model.tz, model.wt, 1.0, False, mt, mr)
+        kernels.lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
         masses.append(mr)
     assert masses[1].min() > 0.0
     np.testing.assert_allclose(masses[0], masses[1], rtol=1e-12)

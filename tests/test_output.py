@@ -146,7 +146,7 @@ def test_sub_cells_carry_their_gauss_points_values_and_the_nodal_version_is_exac
     point_data, cell_data = frame_fields(run.sim, mesh, ["green_lagrange_strain"])
     exx = lambda x: 2 * a * x + 2 * a ** 2 * x ** 2  # noqa: E731
     corners = mesh.points[mesh.cells]  # (C, 4, 3)
-    gauss_x = np.einsum("qa,ea->eq", run.model.N[:9], run.model.x0[run.model.conn][:, :, 0]).reshape(-1)
+    gauss_x = np.einsum("qa,ea->eq", run.model.rule.N[:9], run.model.x0[run.model.conn][:, :, 0]).reshape(-1)
     inside = (corners[:, :, 0].min(axis=1) < gauss_x) & (gauss_x < corners[:, :, 0].max(axis=1))
     assert inside.all()
     np.testing.assert_allclose(cell_data["green_lagrange_strain"][:, 0], exx(gauss_x), rtol=1e-10)
@@ -162,7 +162,7 @@ def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_v
     run = _plate_simulation(lambda x0: np.column_stack([zero(x0), zero(x0), 0.001 * x0[:, 0] ** 2]),
                             lambda x0: np.column_stack([-0.002 * x0[:, 0], zero(x0), 1 + zero(x0)]))
     run.sim.evaluate_forces()
-    nt = len(run.model.tz)
+    nt = len(run.model.rule.tz)
     _, solid = frame_fields(run.sim, output_mesh(run.model, solid=True), ["cauchy_stress", "von_mises"])
     _, shell = frame_fields(run.sim, output_mesh(run.model), ["cauchy_stress", "von_mises"])
     sigma = solid["cauchy_stress"].reshape(-1, 3, 3)
@@ -170,7 +170,7 @@ def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_v
     np.testing.assert_allclose(solid["von_mises"], np.sqrt(1.5 * (deviator ** 2).sum(axis=(1, 2))), rtol=1e-12)
     by_layer = solid["von_mises"].reshape(run.model.n_elements, nt, 9)
     np.testing.assert_array_equal(shell["von_mises"], by_layer.max(axis=1).ravel())
-    weights = run.model.wt / run.model.wt.sum()
+    weights = run.model.rule.wt / run.model.rule.wt.sum()
     mean = np.einsum("k,ekqc->eqc", weights, solid["cauchy_stress"].reshape(run.model.n_elements, nt, 9, 9))
     np.testing.assert_allclose(shell["cauchy_stress"], mean.reshape(-1, 9), rtol=1e-12, atol=1e-15)
     assert (by_layer.max(axis=1) > 1.2 * by_layer.min(axis=1)).any()  # the faces differ: the choice matters
@@ -179,7 +179,7 @@ def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_v
 def test_solid_view_puts_the_faces_half_a_fibre_from_the_mid_surface():
     run = _plate_simulation(lambda x0: np.zeros_like(x0))
     solid = output_mesh(run.model, solid=True)
-    nt = len(run.model.tz)
+    nt = len(run.model.rule.tz)
     assert solid.cells.shape == (run.model.n_elements * 9 * nt, 8)
     assert solid.points.shape == (run.model.n_elements * (nt + 1) * 16, 3)
     z = solid.points[:, 2].reshape(run.model.n_elements, nt + 1, 16)

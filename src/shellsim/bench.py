@@ -50,7 +50,7 @@ def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:
     deck = parse_deck(text.replace("around = 6, along = 6", f"around = {divisions}, along = {divisions}"))
     sim = Simulation(build_model(deck, build_mesh(deck)))
     us = _us_per_element_step(sim, steps, 1.25)
-    flops = flops_per_element(len(sim.model.tz))
+    flops = flops_per_element(len(sim.model.rule.tz))
     return {"elements": sim.model.n_elements, "steps": steps, "us_per_element_step": us,
             "flops_per_element_step": flops, "gflops": flops / (us * 1e3)}
 

@@ -299,7 +299,8 @@ def report(
             error = "-" if row["error_percent"] is None else f"{row['error_percent']:.3g}%"
             out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
 
-        run_jobs(jobs, client, on_row)
+        # a local cluster has one worker process per core: one kernel thread per job
+        run_jobs(jobs, client, on_row, threads=1 if scheduler is None else None)
     written = [folder / name for name in ("report.md", "report.csv", "error_vs_time.png")]
     if embed_in is not None:
         embed(embed_in, study.stem, list(rows_in_order(jobs, rows)))

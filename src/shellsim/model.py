@@ -1,4 +1,5 @@
-"""Deck + Mesh -> Model: the flat arrays the compiled kernels see, and nothing else.
+"""Deck + Mesh -> Model (:class:`shellsim.bundles.Model`): the arrays the compiled kernels
+see, and nothing else.
 
 Boundary conditions become, per node, a projector on the translational velocity and a
 free/fixed flag for each of the two rotational DOFs, with the nodal fibre frame turned so
@@ -10,15 +11,16 @@ the index of its time curve (-1: constant).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from .bundles import (Body, Constraints, Curves, EdgePressureLoads, Loads, Material, Model, NodalLoads, Prescribed,
+                      PressureLoads, Rule, Shape, slots_by_node)
 from .deck import Deck
-from .element import kernels
 from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .errors import NotYetAvailable
+from .loads.edge_pressure import EDGE_DN, EDGE_N, EDGE_W
+from .loads.pressure import pressure_forces
 from .materials import hyperelastic
 from .materials.linear import SHEAR_FACTOR, reduced_lamina_matrix
 from .mesh import Mesh
@@ -27,86 +29,8 @@ AXES = {"x": 0, "y": 1, "z": 2}
 FACES = {"bottom": -1, "mid": 0, "top": 1}
 
 
-@dataclass
-class Model:
-    """Everything the time loop needs, as arrays (shapes in brackets, n nodes, ne elements).
-
-    x0, d0 [n, 3]: initial mid-surface and directors; h0 [n]: fibre lengths;
-    e1f0 [n, 3]: initial fibre-frame first axes; conn [ne, 9].
-    N, dNr, dNs [25, 9]: shape functions at the 3 x 3 integration points and the
-    membrane tying points; tie [3, nq, 6], tie_points [3, 6]: the tying interpolation;
-    wq [nq]: in-plane weights; tz, wt [nt]: thickness rule.
-    jac0_inv [ne, 25, nt, 3, 3]: inverse initial Jacobians.
-    C [5, 5]: reduced lamina matrix (small-strain law); material: (law, params [4],
-    axes0 [ne, nq, nt, 3, 3] or [1, ...] unused, h0 [n], thickness_update) for the kernels
-    (:func:`shellsim.element.kernels.internal_forces`); vol_basis [nq, nb]: fields the in-plane volumetric
-    strain is projected on (plane strain: 1, r, s; otherwise nb = 0, no projection);
-    density; mass 'M1'/'M2'; damping [1/s].
-    projector [n, 3, 3]: allowed translational velocity; rot_free [n, 2]: 1 free, 0 fixed.
-    prescribed_*: nodes, axes, values, curves of prescribed translations.
-    dead_force [F, n, 3] with dead_force_curve [F]; dead_moment [M, n, 3] with
-    dead_moment_curve [M] (moment loads only, so a scene without them does no moment work).
-    pressure_elements, pressure_face, pressure_value, pressure_curve [P].
-    edge_pressure_edges [E, 3], edge_pressure_outward, edge_pressure_value, edge_pressure_curve [E].
-    curve_t, curve_v [C, K] padded tables; curve_len, curve_interp, curve_extrap [C].
-    """
-
-    x0: np.ndarray
-    d0: np.ndarray
-    h0: np.ndarray
-    e1f0: np.ndarray
-    conn: np.ndarray
-    N: np.ndarray
-    dNr: np.ndarray
-    dNs: np.ndarray
-    tie: np.ndarray
-    tie_points: np.ndarray
-    wq: np.ndarray
-    tz: np.ndarray
-    wt: np.ndarray
-    jac0_inv: np.ndarray
-    C: np.ndarray
-    material: tuple
-    vol_basis: np.ndarray
-    density: float
-    mass: str
-    damping: float
-    incremental: bool
-    projector: np.ndarray
-    rot_free: np.ndarray
-    prescribed_nodes: np.ndarray
-    prescribed_axes: np.ndarray
-    prescribed_values: np.ndarray
-    prescribed_curves: np.ndarray
-    dead_force: np.ndarray
-    dead_force_curve: np.ndarray
-    dead_moment: np.ndarray
-    dead_moment_curve: np.ndarray
-    pressure_elements: np.ndarray
-    pressure_face: np.ndarray
-    pressure_value: np.ndarray
-    pressure_curve: np.ndarray
-    edge_pressure_edges: np.ndarray
-    edge_pressure_outward: np.ndarray
-    edge_pressure_value: np.ndarray
-    edge_pressure_curve: np.ndarray
-    curve_t: np.ndarray
-    curve_v: np.ndarray
-    curve_len: np.ndarray
-    curve_interp: np.ndarray
-    curve_extrap: np.ndarray
-
-    @property
-    def n_nodes(self) -> int:
-        return len(self.x0)
-
-    @property
-    def n_elements(self) -> int:
-        return len(self.conn)
-
-
-def integration_rule(points_through_thickness: int):
-    """(N, dNr, dNs, tie, tie_points, wq, tz, wt) of the element.
+def integration_rule(points_through_thickness: int, plane_strain: bool = False) -> Rule:
+    """The element's :class:`~shellsim.bundles.Rule`.
 
     N, dNr, dNs (25, 9): shape functions and derivatives at the 3 x 3 Gauss points (rows
     0-8, thesis 3.15) and at the membrane tying points (rows 9-24): 2 x 3 points
@@ -114,7 +38,8 @@ def integration_rule(points_through_thickness: int):
     and 2 x 2 for c_rs. tie (3, 9, 6): weights interpolating each component at the
     integration points from its tying points, Lagrange linear along the 2-point direction
     and quadratic along the 3-point one; tie_points (3, 6): their row numbers (rs uses 4;
-    the rest carry weight 0). wq (9,): in-plane weights; tz, wt: thickness rule.
+    the rest carry weight 0). wq (9,): in-plane weights; tz, wt: thickness rule;
+    vol_basis: :func:`volumetric_basis`.
     """
     rs, wq = gauss_rule_2d(3)
     g2, _ = gauss_rule(2)
@@ -138,8 +63,9 @@ def integration_rule(points_through_thickness: int):
     points = np.vstack(points)
     dN = shape_derivatives(points)
     tz, wt = gauss_rule(points_through_thickness)
-    return (shape(points), np.ascontiguousarray(dN[:, :, 0]), np.ascontiguousarray(dN[:, :, 1]),
-            tie, tie_points, wq, tz, wt)
+    N = shape(points)
+    return Rule(N=N, dNr=np.ascontiguousarray(dN[:, :, 0]), dNs=np.ascontiguousarray(dN[:, :, 1]), tie=tie,
+                tie_points=tie_points, wq=wq, tz=tz, wt=wt, vol_basis=volumetric_basis(plane_strain, N[:len(wq)]))
 
 
 def _lagrange(x: np.ndarray, node: float, nodes: np.ndarray) -> np.ndarray:
@@ -153,48 +79,46 @@ def _lagrange(x: np.ndarray, node: float, nodes: np.ndarray) -> np.ndarray:
 
 def build_model(deck: Deck, mesh: Mesh) -> Model:
     """Flatten ``deck`` and ``mesh`` into a :class:`Model`."""
-    material = deck.material
-    N, dNr, dNs, tie, tie_points, wq, tz, wt = integration_rule(deck.section.points_through_thickness)
-    jac0_inv = _initial_inverse_jacobians(mesh, N, dNr, dNs, tz)
-    C, law = _constitutive(deck, mesh, N[:len(wq)], dNr[:len(wq)], dNs[:len(wq)], tz)
-    projector, rot_free, e1f0, prescribed = _boundary_conditions(deck, mesh)
+    rule = integration_rule(deck.section.points_through_thickness, deck.section.plane_strain)
+    conn = mesh.conn.astype(np.int64)
+    node_slots, slots = slots_by_node(conn, mesh.n_nodes)
+    body = Body(conn=conn, jac0_inv=_initial_inverse_jacobians(mesh, rule.N, rule.dNr, rule.dNs, rule.tz),
+                h0=mesh.thickness.copy(), node_slots=node_slots, slots=slots)
+    constraints, e1f0 = _boundary_conditions(deck, mesh)
     curve_names = list(deck.curves)
-    loads = _loads(deck, mesh, curve_names, N, dNr, dNs, wq, tz, wt)
-    tables = _curve_tables(deck, curve_names)
+    initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
     return Model(
-        x0=mesh.x.copy(), d0=mesh.director.copy(), h0=mesh.thickness.copy(), e1f0=e1f0,
-        conn=mesh.conn.astype(np.int64), N=N, dNr=dNr, dNs=dNs, tie=tie, tie_points=tie_points, wq=wq, tz=tz, wt=wt,
-        jac0_inv=jac0_inv, C=C, material=law, vol_basis=volumetric_basis(deck.section.plane_strain, N[:len(wq)]), density=material.density, mass=deck.solver.mass,
+        rule=rule, body=body, material=_material(deck, mesh, rule), loads=_loads(deck, mesh, curve_names, rule, initial),
+        curves=_curve_tables(deck, curve_names), constraints=constraints,
+        x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0, density=deck.material.density, mass=deck.solver.mass,
         damping=deck.solver.damping,
-        incremental=deck.section.formulation == "incremental" or deck.section.technique in (2, 3),
-        projector=projector, rot_free=rot_free, **prescribed, **loads, **tables,
     )
 
 
-def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, tuple]:
-    """The small-strain matrix C (5, 5) and the kernels' material tuple (see :class:`Model`).
+def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
+    """The kernels' :class:`~shellsim.bundles.Material`.
 
     A linear elastic material without a technique is the small-strain path, with
     Technique 1 it is St. Venant-Kirchhoff; a hyperelastic one runs Technique 1 (total
     formulation, zero normal stress by J = 1). Technique 1 needs the material frames at
-    the Gauss points (N, dNr, dNs: (nq, 9)) of the initial shape.
+    the Gauss points of the initial shape.
     """
     material, section = deck.material, deck.section
-    h0 = mesh.thickness.copy()
-    no_axes = np.zeros((1, len(N), len(tz), 3, 3))  # the kernels index it only for Technique 1
+    nq = len(rule.wq)
+    no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
+    constant = dict(law=hyperelastic.LINEAR, params=np.zeros(4), axes0=no_axes, normal_ratio=0.0)
     if not material.HYPERELASTIC and section.technique is None:
-        return (reduced_lamina_matrix(material.E, material.nu, section.plane_strain),
-                (hyperelastic.LINEAR, np.zeros(4), no_axes, h0, False))
+        return Material(C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), technique=0,
+                        incremental=section.formulation == "incremental", thickness_update=False, **constant)
     if section.plane_strain:
         raise NotYetAvailable("section.plane_strain with a large-strain technique is not available; "
                               "plane strain is a small-strain section (Test 7)")
     if not material.HYPERELASTIC and section.technique in (2, 3):
         # constant tensor, stresses accumulated in the lamina frame from each step's
         # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
-        ratio = material.nu / (1.0 - material.nu)
-        return (reduced_lamina_matrix(material.E, material.nu),
-                (hyperelastic.LINEAR, np.array([float(section.technique), ratio, 0.0, 0.0]), no_axes, h0,
-                 deck.thickness_update))
+        return Material(C=reduced_lamina_matrix(material.E, material.nu), technique=section.technique,
+                        incremental=True, thickness_update=deck.thickness_update,
+                        **(constant | {"normal_ratio": material.nu / (1.0 - material.nu)}))
     if section.technique not in (None, 1):
         raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
                               "Technique 1; Techniques 2 and 3 take a linear elastic material")
@@ -207,8 +131,9 @@ def _constitutive(deck: Deck, mesh: Mesh, N, dNr, dNs, tz) -> tuple[np.ndarray, 
         law, params = hyperelastic.GUCCIONE, [material.C1, material.C2, material.C3, material.C4]
     else:
         law, params = hyperelastic.MOONEY_RIVLIN, [material.C1, getattr(material, "C2", 0.0), 0.0, 0.0]
-    axes0 = material_frames(mesh, getattr(material, "axes", None), N, dNr, dNs, tz)
-    return np.zeros((5, 5)), (law, np.asarray(params, dtype=float), axes0, h0, deck.thickness_update)
+    axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
+    return Material(law=law, params=np.asarray(params, dtype=float), C=np.zeros((5, 5)), axes0=axes0, technique=1,
+                    normal_ratio=0.0, incremental=False, thickness_update=deck.thickness_update)
 
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
@@ -271,12 +196,14 @@ def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
     return out
 
 
-def _boundary_conditions(deck: Deck, mesh: Mesh):
+def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarray]:
+    """The supports as :class:`~shellsim.bundles.Constraints`, and the initial fibre frames
+    (n, 3) turned so that a director constraint is one rotational DOF."""
     n = mesh.n_nodes
     constrained: list[list[np.ndarray]] = [[] for _ in range(n)]
     planes: list[list[np.ndarray]] = [[] for _ in range(n)]
     director_fixed = np.zeros(n, dtype=bool)
-    prescribed = {"prescribed_nodes": [], "prescribed_axes": [], "prescribed_values": [], "prescribed_curves": []}
+    prescribed: dict[str, list] = {"nodes": [], "axes": [], "values": [], "curves": []}
     axes = np.eye(3)
     for bc in deck.boundary:
         nodes = mesh.sets[bc.set].nodes
@@ -291,10 +218,10 @@ def _boundary_conditions(deck: Deck, mesh: Mesh):
         else:  # prescribed
             directions, plane, fixed = [axes[AXES[bc.translation]]], None, False
             for node in nodes:
-                prescribed["prescribed_nodes"].append(node)
-                prescribed["prescribed_axes"].append(AXES[bc.translation])
-                prescribed["prescribed_values"].append(bc.value)
-                prescribed["prescribed_curves"].append(_curve_index(deck, bc.curve))
+                prescribed["nodes"].append(node)
+                prescribed["axes"].append(AXES[bc.translation])
+                prescribed["values"].append(bc.value)
+                prescribed["curves"].append(_curve_index(deck, bc.curve))
         for node in nodes:
             constrained[node].extend(directions)
             if plane is not None:
@@ -316,13 +243,11 @@ def _boundary_conditions(deck: Deck, mesh: Mesh):
             # move along it, which is the first rotational DOF.
             e1f0[node] = in_plane[0]
             rot_free[node, 0] = 0.0
-    arrays = {
-        "prescribed_nodes": np.asarray(prescribed["prescribed_nodes"], dtype=np.int64),
-        "prescribed_axes": np.asarray(prescribed["prescribed_axes"], dtype=np.int64),
-        "prescribed_values": np.asarray(prescribed["prescribed_values"], dtype=float),
-        "prescribed_curves": np.asarray(prescribed["prescribed_curves"], dtype=np.int64),
-    }
-    return projector, rot_free, e1f0, arrays
+    moved = Prescribed(nodes=np.asarray(prescribed["nodes"], dtype=np.int64),
+                       axes=np.asarray(prescribed["axes"], dtype=np.int64),
+                       values=np.asarray(prescribed["values"], dtype=float),
+                       curves=np.asarray(prescribed["curves"], dtype=np.int64))
+    return Constraints(projector=projector, rot_free=rot_free, prescribed=moved), e1f0
 
 
 def _orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarray]:
@@ -340,7 +265,7 @@ def _curve_index(deck: Deck, name: str | None) -> int:
     return -1 if name is None else list(deck.curves).index(name)
 
 
-def _curve_tables(deck: Deck, names: list[str]) -> dict[str, np.ndarray]:
+def _curve_tables(deck: Deck, names: list[str]) -> Curves:
     size = max([len(deck.curves[c].t) for c in names], default=1)
     t = np.zeros((max(len(names), 1), size))
     v = np.zeros_like(t)
@@ -351,17 +276,20 @@ def _curve_tables(deck: Deck, names: list[str]) -> dict[str, np.ndarray]:
         times, values, interp[i], extrap[i] = deck.curves[name].table()
         length[i] = len(times)
         t[i, :len(times)], v[i, :len(times)] = times, values
-    return {"curve_t": t, "curve_v": v, "curve_len": length, "curve_interp": interp, "curve_extrap": extrap}
+    return Curves(t=t, v=v, length=length, interp=interp, extrap=extrap)
 
 
 def _edge_integral(x0: np.ndarray, edges: np.ndarray) -> np.ndarray:
     """Consistent nodal weights int N_k ds over edge segments (m, 3) on the initial
     geometry: (m, 3) lengths (1/6 : 4/6 : 1/6 of a straight segment)."""
-    tangent = np.einsum("pk,mki->mpi", kernels.EDGE_DN, x0[edges])
-    return np.einsum("pk,mp,p->mk", kernels.EDGE_N, np.linalg.norm(tangent, axis=-1), kernels.EDGE_W)
+    tangent = np.einsum("pk,mki->mpi", EDGE_DN, x0[edges])
+    return np.einsum("pk,mp,p->mk", EDGE_N, np.linalg.norm(tangent, axis=-1), EDGE_W)
 
 
-def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict[str, np.ndarray]:
+def _loads(deck: Deck, mesh: Mesh, curve_names, rule: Rule, initial: Shape) -> Loads:
+    """Every load of ``deck`` as tables (:class:`~shellsim.bundles.Loads`): dead nodal
+    vectors (edge, point, body, dead pressure, taken on the ``initial`` shape) and
+    follower pressures evaluated every step, each with its curve's index."""
     n = mesh.n_nodes
     dead_force, dead_force_curve, dead_moment, dead_moment_curve = [], [], [], []
     pressure = {"elements": [], "face": [], "value": [], "curve": []}
@@ -384,16 +312,17 @@ def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict
             continue
         if load.type == "pressure":  # dead: forces of the initial face, kept fixed
             g = np.zeros((n, 3))
-            kernels.pressure_forces(mesh.x, mesh.director, mesh.thickness, mesh.conn.astype(np.int64),
-                                    named.elements.astype(np.int64), np.full(len(named.elements), FACES[load.face]),
-                                    np.full(len(named.elements), load.value), N, dNr, dNs, wq, force, g)
+            faces = PressureLoads(elements=named.elements.astype(np.int64),
+                                  face=np.full(len(named.elements), FACES[load.face]),
+                                  value=np.full(len(named.elements), load.value), curve=np.full(len(named.elements), -1))
+            pressure_forces(rule, mesh.conn.astype(np.int64), initial, faces, faces.value, force, g)
         elif load.type in ("edge_force", "edge_moment"):
             target = force if load.type == "edge_force" else moment
             np.add.at(target, named.edges, _edge_integral(mesh.x, named.edges)[:, :, None] * np.asarray(load.value))
         elif load.type in ("point_force", "point_moment"):
             (force if load.type == "point_force" else moment)[named.nodes] += np.asarray(load.value)
         else:  # body force per unit initial volume
-            volume_weights = _nodal_volumes(mesh, named.elements, N, dNr, dNs, wq, tz, wt)
+            volume_weights = _nodal_volumes(mesh, named.elements, rule)
             force += volume_weights[:, None] * np.asarray(load.value)
         if load.type in ("edge_moment", "point_moment"):
             dead_moment.append(moment)
@@ -405,29 +334,27 @@ def _loads(deck: Deck, mesh: Mesh, curve_names, N, dNr, dNs, wq, tz, wt) -> dict
     def cat(parts, dtype, shape=(0,)):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype=dtype)
 
-    return {
-        "dead_force": np.asarray(dead_force).reshape(-1, n, 3),
-        "dead_force_curve": np.asarray(dead_force_curve, dtype=np.int64),
-        "dead_moment": np.asarray(dead_moment).reshape(-1, n, 3),
-        "dead_moment_curve": np.asarray(dead_moment_curve, dtype=np.int64),
-        "pressure_elements": cat(pressure["elements"], np.int64),
-        "pressure_face": cat(pressure["face"], np.int64),
-        "pressure_value": cat(pressure["value"], float),
-        "pressure_curve": cat(pressure["curve"], np.int64),
-        "edge_pressure_edges": cat(edge_pressure["edges"], np.int64, (0, 3)),
-        "edge_pressure_outward": cat(edge_pressure["outward"], float),
-        "edge_pressure_value": cat(edge_pressure["value"], float),
-        "edge_pressure_curve": cat(edge_pressure["curve"], np.int64),
-    }
+    return Loads(
+        force=NodalLoads(vectors=np.asarray(dead_force).reshape(-1, n, 3),
+                         curve=np.asarray(dead_force_curve, dtype=np.int64)),
+        moment=NodalLoads(vectors=np.asarray(dead_moment).reshape(-1, n, 3),
+                          curve=np.asarray(dead_moment_curve, dtype=np.int64)),
+        pressure=PressureLoads(elements=cat(pressure["elements"], np.int64), face=cat(pressure["face"], np.int64),
+                               value=cat(pressure["value"], float), curve=cat(pressure["curve"], np.int64)),
+        edge_pressure=EdgePressureLoads(edges=cat(edge_pressure["edges"], np.int64, (0, 3)),
+                                        outward=cat(edge_pressure["outward"], float),
+                                        value=cat(edge_pressure["value"], float),
+                                        curve=cat(edge_pressure["curve"], np.int64)),
+    )
 
 
-def _nodal_volumes(mesh: Mesh, elements, N, dNr, dNs, wq, tz, wt) -> np.ndarray:
+def _nodal_volumes(mesh: Mesh, elements, rule: Rule) -> np.ndarray:
     """int N_a dV over ``elements`` on the initial configuration, per node: (n,)."""
-    nq = len(wq)
-    jac_inv = _initial_inverse_jacobians(mesh, N[:nq], dNr[:nq], dNs[:nq], tz)[elements]
-    dv = np.einsum("q,t,eqt->eqt", wq, wt, 1.0 / np.linalg.det(jac_inv))
+    nq = len(rule.wq)
+    jac_inv = _initial_inverse_jacobians(mesh, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)[elements]
+    dv = np.einsum("q,t,eqt->eqt", rule.wq, rule.wt, 1.0 / np.linalg.det(jac_inv))
     out = np.zeros(mesh.n_nodes)
-    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", N[:nq], dv))
+    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", rule.N[:nq], dv))
     return out
 
 

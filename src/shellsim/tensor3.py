@@ -6,7 +6,7 @@ from __future__ import annotations
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def det3(A):
     """Determinant of A (3, 3)."""
     return (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
@@ -14,7 +14,7 @@ def det3(A):
             + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def congruence(a, m, b, out):
     """out = a m b^T, all (3, 3); out must be none of the inputs. With a = b = q it turns
     a global tensor into the frame q (rows: its axes), with q.T back."""

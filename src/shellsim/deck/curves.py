@@ -6,9 +6,9 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from pydantic import field_validator, model_validator
 
+from ..curve_tables import EXTRAPOLATION, INTERPOLATION, curve_value
 from .types import Real, Section
 
 
@@ -60,28 +60,3 @@ class Curve(Section):
         """(times, values, interpolation code, extrapolation code) for :func:`curve_value`."""
         return (np.asarray(self.t, dtype=float), np.asarray(self.value, dtype=float),
                 INTERPOLATION[self.interpolate], EXTRAPOLATION[self.extrapolate])
-
-
-INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2}
-EXTRAPOLATION = {"constant": 0, "linear": 1}
-
-
-@njit(cache=True)
-def curve_value(t: np.ndarray, v: np.ndarray, interpolate: int, extrapolate: int, time: float) -> float:
-    """A curve's factor at ``time``; codes as in INTERPOLATION and EXTRAPOLATION. Used by
-    :class:`Curve` and inside the compiled time loop alike."""
-    n = t.shape[0]
-    if n == 1:
-        return v[0]
-    if time <= t[0] or time >= t[n - 1]:
-        i = 0 if time <= t[0] else n - 2
-        if extrapolate == 1:
-            return v[i] + (time - t[i]) / (t[i + 1] - t[i]) * (v[i + 1] - v[i])
-        return v[0] if time <= t[0] else v[n - 1]
-    i = np.searchsorted(t, time, side="right") - 1
-    u = (time - t[i]) / (t[i + 1] - t[i])
-    if interpolate == 1:
-        return v[i]
-    if interpolate == 2:
-        u = u * u * (3.0 - 2.0 * u)
-    return v[i] + u * (v[i + 1] - v[i])

@@ -27,7 +27,7 @@ def normalize(a: np.ndarray) -> None:
     a[2] /= n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def lamina_frame(jac: np.ndarray, q: np.ndarray) -> None:
     """Hughes' lamina basis at a point from the tangents g_r = jac[:, 0], g_s = jac[:, 1].
 
@@ -55,7 +55,7 @@ def lamina_frame(jac: np.ndarray, q: np.ndarray) -> None:
     q[2, 0], q[2, 1], q[2, 2] = nx, ny, nz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def initial_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     """Hughes' fibre basis for a director d (3,): writes e1f into e1 (3,); e2f = d x e1f.
 
@@ -77,7 +77,7 @@ def initial_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     cross(e2, d, e1)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     """The thesis' new fibre-frame update (3.3.2): e2f = d x e1f(previous), e1f = e2f x d.
 
@@ -91,7 +91,7 @@ def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     cross(e2, d, e1)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: float) -> None:
     """Director update by trial increment and normalisation (thesis 3.2, Eq 2.62):
     d <- (d - dtheta1 e1f - dtheta2 e2f) / |...|, then the fibre frame follows. In place."""
@@ -101,3 +101,27 @@ def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: floa
         d[i] -= dtheta1 * e1[i] + dtheta2 * e2[i]
     normalize(d)
     update_fibre_frame(d, e1)
+
+
+@njit(cache=True, error_model="numpy")
+def to_rotational(g, d, e1, out):
+    """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
+    (-e1f.g, -e2f.g), e2f = d x e1f."""
+    for n in range(g.shape[0]):
+        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
+        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
+        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
+        out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def director_increments(w, d, e1, out):
+    """Director increments (n, 3) of rotational DOF values w (n, 2): -w1 e1f - w2 e2f."""
+    for n in range(w.shape[0]):
+        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
+        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
+        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        out[n, 0] = -w[n, 0] * e1[n, 0] - w[n, 1] * e2x
+        out[n, 1] = -w[n, 0] * e1[n, 1] - w[n, 1] * e2y
+        out[n, 2] = -w[n, 0] * e1[n, 2] - w[n, 1] * e2z

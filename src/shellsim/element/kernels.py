@@ -24,15 +24,17 @@ Array layout: element axis first; (ne, n_q, n_t, ...) for point data.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
-from numba import njit
+from numba import get_num_threads, njit, prange
 
 from ..materials import hyperelastic
 from ..tensor3 import congruence, det3
-from .frames import lamina_frame
+from .frames import director_increments, lamina_frame, to_rotational
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
     """Current Jacobian, its inverse, lamina frame and the gradient vectors at one point.
 
@@ -69,7 +71,7 @@ def _point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, gN, gM):
     return det
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lamina_to_global(s5, q, sg):
     """Global stress sg (3, 3) = q^T sigma^l q from lamina (s11, s22, s12, s13, s23)."""
     for i in range(3):
@@ -81,7 +83,7 @@ def _lamina_to_global(s5, q, sg):
             sg[i, j] = t0 * q[0, j] + t1 * q[1, j] + t2 * q[2, j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _global_to_lamina_strain(eg, q, e5, v):
     """Lamina strain vector (e11, e22, 2e12, 2e13, 2e23) of q eg q^T, eg (3, 3) symmetric;
     v (3, 3) scratch."""
@@ -96,7 +98,7 @@ def _global_to_lamina_strain(eg, q, e5, v):
     e5[4] = 2.0 * (q[1, 0] * v[2, 0] + q[1, 1] * v[2, 1] + q[1, 2] * v[2, 2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _accumulate(sg, gN, gM, dv, fe, ge):
     """fe[a] += sg gN[a] dv, ge[a] += sg gM[a] dv, for the 9 nodes."""
     for a in range(9):
@@ -105,7 +107,7 @@ def _accumulate(sg, gN, gM, dv, fe, ge):
             ge[a, i] += (sg[i, 0] * gM[a, 0] + sg[i, 1] * gM[a, 1] + sg[i, 2] * gM[a, 2]) * dv
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _gradient_of(ue, ve, gN, gM, L):
     """L (3, 3) = sum_a ue[a] (x) gN[a] + ve[a] (x) gM[a]."""
     for i in range(3):
@@ -116,35 +118,11 @@ def _gradient_of(ue, ve, gN, gM, L):
             L[i, j] = acc
 
 
-@njit(cache=True)
-def _to_rotational(g, d, e1, out):
-    """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
-    (-e1f.g, -e2f.g), e2f = d x e1f."""
-    for n in range(g.shape[0]):
-        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
-        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
-        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
-        out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
-        out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
-
-
-@njit(cache=True)
-def director_increments(w, d, e1, out):
-    """Director increments (n, 3) of rotational DOF values w (n, 2): -w1 e1f - w2 e2f."""
-    for n in range(w.shape[0]):
-        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
-        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
-        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
-        out[n, 0] = -w[n, 0] * e1[n, 0] - w[n, 1] * e2x
-        out[n, 1] = -w[n, 0] * e1[n, 1] - w[n, 1] * e2y
-        out[n, 2] = -w[n, 0] * e1[n, 2] - w[n, 1] * e2z
-
-
 #: Modes of :func:`_element_response`.
 TOTAL, INCREMENTAL, LINEAR = 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _almansi(F, eg, B):
     """Almansi strain eg = 1/2 (I - (F F^T)^-1) of a deformation gradient F (3, 3); B (3, 3)
     scratch. A degenerate F gives non-finite values (no exception), which the time loop
@@ -161,9 +139,9 @@ def _almansi(F, eg, B):
     eg[1, 2] = eg[2, 1] = -0.5 * (B[0, 2] * B[1, 0] - B[0, 0] * B[1, 2]) / det
 
 
-@njit(cache=True)
-def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis, law, params,
-                      axes0, stress, state_stress, stretch, fe, ge, work):
+@njit(cache=True, error_model="numpy")
+def _element_response(mode, xe, de, he, ue, ve, jac0_inv, rule, material, axes0, stress, state_stress, stretch, fe, ge,
+                      work):
     """Stresses and nodal forces of one element, with assumed membrane and shear strains.
 
     mode: TOTAL (stress from the total Almansi strain), INCREMENTAL (stress plus C~ times
@@ -187,13 +165,14 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     reproduced exactly; the virtual work of sigma . delta eps* puts effective stresses at
     the tying points too.
 
-    Constitutive law: ``law`` LINEAR uses the reduced matrix C (5, 5); a hyperelastic law
+    Constitutive law (``material``, :class:`shellsim.bundles.Material`): the law LINEAR
+    uses the reduced matrix C (5, 5); a hyperelastic law
     (:mod:`shellsim.materials.hyperelastic`, Technique 1, TOTAL and LINEAR modes) takes
-    its parameters ``params`` (4,) and the initial material frames ``axes0`` (nq, nt, 3, 3)
-    (see :func:`_hyperelastic_point`).
+    its parameters and the element's initial material frames ``axes0`` (nq, nt, 3, 3)
+    (see :func:`_hyperelastic_point`). ``rule``: :class:`shellsim.bundles.Rule`.
 
     xe, de (9, 3), he (9,), ue, ve (9, 3); jac0_inv (npts, nt, 3, 3);
-    Techniques 2 and 3 (law LINEAR, INCREMENTAL, params = (technique, nu / (1 - nu), -, -))
+    Techniques 2 and 3 (law LINEAR, INCREMENTAL)
     add C times the step's strain increment to the stresses kept in the lamina frame,
     turn them with the material's spin relative to that frame, and (2) push them forward
     with the step's stretch (:func:`_convect`).
@@ -203,14 +182,22 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
     and 3); else left alone;
     state_stress (nq, nt, 5): the current stress, whose initial-stress stiffness LINEAR adds
     to the material one (the critical step of a stretched membrane is set by both);
-    fe, ge (9, 3) overwritten; work: scratch from :func:`_scratch`.
+    fe, ge (9, 3) overwritten; work: an :class:`ElementScratch`.
     """
-    (jac, jinv, q, gN, gM, Q, GN, GM, DV, EPS, sg, eg, F, G, jinv_all, cbar, Bab, T, plane, glob,
-     local, s5, v, cov, delta, A, cov_shear, TS, SW, coef, rhs, Mb, FP, EPS0, Ct, Emean, LP, M3) = work
+    N, dNr, dNs, tie, tie_points, wq, tz, wt = rule.N, rule.dNr, rule.dNs, rule.tie, rule.tie_points, rule.wq, rule.tz, rule.wt
+    law, params, C, technique = material.law, material.params, material.C, material.technique
+    jac, jinv, q, gN, gM, sg, eg, F = work.jac, work.jinv, work.q, work.gN, work.gM, work.sg, work.eg, work.F
+    plane, glob, local, v, s5, cov, delta = work.plane, work.glob, work.local, work.v, work.s5, work.cov, work.delta
+    Q, GN, GM, G, jinv_all, A, DV = work.Q, work.GN, work.GM, work.G, work.jinv_all, work.A, work.DV
+    EPS, EPS0, FP, LP, SW = work.EPS, work.EPS0, work.FP, work.LP, work.SW
+    cbar, Bab, T, cov_shear, TS = work.cbar, work.Bab, work.T, work.cov_shear, work.TS
+    coef, rhs, Mb, Ct, Emean, M3 = work.coef, work.rhs, work.Mb, work.Ct, work.Emean, work.M3
     hyper = law != hyperelastic.LINEAR
+    # Techniques 2 and 3: stresses accumulated from strain increments, turned and stretched
+    convected = mode == INCREMENTAL and technique >= 2
     # the field's (or the step's) gradient serves the initial-stress stiffness (LINEAR) and
     # the spin correction of Techniques 2 and 3
-    keep_gradient = mode == LINEAR or (mode == INCREMENTAL and params[0] > 0.0)
+    keep_gradient = mode == LINEAR or convected
     nq = wq.shape[0]
     npts = N.shape[0]
     nt = tz.shape[0]
@@ -291,12 +278,13 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         acc += tie[c, p, m] * cov_shear[tie_points[c, m], k, c]
                 delta[c] = acc
             _solve2(A[p, k], delta[0], delta[1], EPS[p, k, 3:5])
+    vol_basis = rule.vol_basis
     nb = vol_basis.shape[1]
     if nb:
         _project_volumetric(EPS, DV, vol_basis, nq, nt, False, coef, rhs, Mb)
     for p in range(nq):
         Emean[:] = 0.0
-        if mode == INCREMENTAL and params[0] > 0.0:
+        if convected:
             stretch[p] = 1.0
         for k in range(nt):
             if hyper and mode == TOTAL:
@@ -320,10 +308,10 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                         stress[p, k, i] += acc
                     else:
                         stress[p, k, i] = acc
-                if mode == INCREMENTAL and params[0] > 0.0:  # Techniques 2 and 3
-                    normal = -params[1] * (EPS[p, k, 0] + EPS[p, k, 1])
+                if convected:
+                    normal = -material.normal_ratio * (EPS[p, k, 0] + EPS[p, k, 1])
                     stretch[p] += wt[k] / wsum * normal
-                    if params[0] == 2.0:
+                    if technique == 2:
                         _convect(stress[p, k], EPS[p, k], normal, local, glob, eg)
                     _follow_material_spin(stress[p, k], LP[p, k], Q[p, k], G[p, k], local)
             for i in range(3):
@@ -398,7 +386,7 @@ def _element_response(mode, xe, de, he, ue, ve, jac0_inv, N, dNr, dNs, tie, tie_
                 _accumulate(eg, GN[p, k], GM[p, k], DV[p, k], fe, ge)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent, Emean, share, M3, v5):
     """Technique 1 at one point (thesis 3.10.1): lamina Cauchy stress out5 (5,) from a
     hyperelastic law, or (want_tangent) its tangent Ct (5, 5) in the current lamina frame.
@@ -448,7 +436,7 @@ def _hyperelastic_point(law, params, R0, q, F, eps, eps0, out5, Ct, want_tangent
     return volume / det
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _follow_material_spin(s5, L, q, g, Ll):
     """Turn accumulated lamina stresses s5 (5,) by the step's in-plane spin of the
     material relative to the lamina frame.
@@ -480,7 +468,7 @@ def _follow_material_spin(s5, L, q, g, Ll):
     s5[4] = s * s13 + c * s23
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _convect(s5, e5, normal, M, T, out):
     """Technique 2's push-forward of the accumulated stress (thesis Eqs 3.29-3.30) over
     one step: sigma <- M sigma M / det M, M = I + the step's lamina strain increment
@@ -500,7 +488,7 @@ def _convect(s5, e5, normal, M, T, out):
     _push_forward(M, T, det3(M), out, s5)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _add_strain_tensor(e5, scale, D):
     """D (3, 3) += scale x the lamina tensor of the strains e5 (11, 22, 2x12, 2x13, 2x23)
     (engineering shears halved); D[2, 2] untouched."""
@@ -514,7 +502,7 @@ def _add_strain_tensor(e5, scale, D):
     D[2, 1] += 0.5 * scale * e5[4]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _push_forward(Fl, S, det, tmp, out5):
     """Lamina components (11, 22, 12, 13, 23) of Fl S Fl^T / det; tmp (3, 3) scratch."""
     congruence(Fl, S, Fl, tmp)
@@ -525,7 +513,7 @@ def _push_forward(Fl, S, det, tmp, out5):
     out5[4] = tmp[1, 2] / det
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _project_volumetric(V, DV, basis, nq, nt, adjoint, coef, rhs, Mb):
     """In-plane volumetric strain projected, layer by layer, on the fields of ``basis``
     (nq, nb): with (1, r, s) the 9-node quadrilateral becomes Q9/P3, free of volumetric
@@ -556,7 +544,7 @@ def _project_volumetric(V, DV, basis, nq, nt, adjoint, coef, rhs, Mb):
             V[q, k, 1] += change
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _projection_system(DV, basis, nq, k, Mb):
     """Mb (nb, nb) = sum_p DV(p, k) phi(p) phi(p)^T, the Gram matrix of the projection."""
     nb = basis.shape[1]
@@ -567,7 +555,7 @@ def _projection_system(DV, basis, nq, k, Mb):
                 Mb[i, j] += DV[p, k] * basis[p, i] * basis[p, j]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lamina_tangents(q, g, out):
     """Lamina in-plane components out (2, 2) of the tangents g (2, 3): out[a, i] = g_a . e_i."""
     for a in range(2):
@@ -575,7 +563,7 @@ def _lamina_tangents(q, g, out):
             out[a, i] = q[i, 0] * g[a, 0] + q[i, 1] * g[a, 1] + q[i, 2] * g[a, 2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _solve2(A, b0, b1, out):
     """out[:2] = A^-1 (b0, b1) for A (2, 2)."""
     det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
@@ -583,7 +571,7 @@ def _solve2(A, b0, b1, out):
     out[1] = (A[0, 0] * b1 - A[1, 0] * b0) / det
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _lamina_strain_tensor(e5, q, plane, out):
     """The in-plane part (11, 22, 12) of lamina strains e5 as a global tensor out (3, 3)."""
     plane[:] = 0.0
@@ -593,7 +581,7 @@ def _lamina_strain_tensor(e5, q, plane, out):
     _rotate(q.T, plane, out)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _covariant(e, g, cov):
     """Covariant components (rr, ss, rs) of a global tensor e with tangents g (2, 3)."""
     for c, (a, b) in enumerate(((0, 0), (1, 1), (0, 1))):
@@ -604,7 +592,7 @@ def _covariant(e, g, cov):
         cov[c] = acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _contravariant_tensor(c, jinv, out):
     """Global tensor sum_ab g^a (x) g^b c_ab (ordered pairs, c_rs counted twice), with the
     contravariant vectors g^a = jinv[a] (rows of the inverse Jacobian)."""
@@ -614,7 +602,7 @@ def _contravariant_tensor(c, jinv, out):
                          + c[2] * (jinv[0, i] * jinv[1, j] + jinv[1, i] * jinv[0, j]))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _contract_contravariant(s, jinv, out):
     """(g^r.s.g^r, g^s.s.g^s, 2 g^r.s.g^s) of a global tensor s (3, 3): the adjoint of
     :func:`_contravariant_tensor`."""
@@ -626,28 +614,124 @@ def _contract_contravariant(s, jinv, out):
         out[c] = factor * acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _rotate(q, A, out):
     """out = q A q^T, all (3, 3): global tensor to lamina components with q, and back with
     q.T."""
     congruence(q, A, q, out)
 
 
-@njit(cache=True)
+class ElementScratch(NamedTuple):
+    """Work arrays of :func:`_element_response` for one element at a time: at one point
+    (3, 3) jac, jinv, q, sg, eg, F, plane, glob, local, v; (9, 3) gN, gM; s5 (5,); cov,
+    delta (3,); Ct (5, 5); Emean (3, 3); M3 (8, 3, 3) for :func:`_hyperelastic_point`.
+    At every point (npts, nt, ...): Q, jinv_all (3, 3) lamina frames and inverse
+    Jacobians, GN, GM (9, 3) gradient vectors, G (2, 3) tangents, A (2, 2) their lamina
+    components, DV point volumes, EPS (5) lamina strains, cov_shear and TS (2) covariant
+    shears and their tying-point stresses, SW (3) volume-weighted in-plane stresses;
+    per in-plane point (npts, 3) cbar, Bab, T; at the Gauss points (nq, nt, ...) FP and
+    LP (3, 3) deformation and field gradients, EPS0 (5) strains before the tying;
+    coef, rhs (nb,), Mb (nb, nb) of the volumetric projection. Then one element's
+    gathered xe, de, ue, ve (9, 3), he (9,), its forces fe, ge (9, 3) and normal
+    stretches stretch (nq,)."""
+
+    jac: np.ndarray
+    jinv: np.ndarray
+    q: np.ndarray
+    sg: np.ndarray
+    eg: np.ndarray
+    F: np.ndarray
+    plane: np.ndarray
+    glob: np.ndarray
+    local: np.ndarray
+    v: np.ndarray
+    gN: np.ndarray
+    gM: np.ndarray
+    s5: np.ndarray
+    cov: np.ndarray
+    delta: np.ndarray
+    Ct: np.ndarray
+    Emean: np.ndarray
+    M3: np.ndarray
+    Q: np.ndarray
+    jinv_all: np.ndarray
+    GN: np.ndarray
+    GM: np.ndarray
+    G: np.ndarray
+    A: np.ndarray
+    DV: np.ndarray
+    EPS: np.ndarray
+    cov_shear: np.ndarray
+    TS: np.ndarray
+    SW: np.ndarray
+    cbar: np.ndarray
+    Bab: np.ndarray
+    T: np.ndarray
+    FP: np.ndarray
+    LP: np.ndarray
+    EPS0: np.ndarray
+    coef: np.ndarray
+    rhs: np.ndarray
+    Mb: np.ndarray
+    xe: np.ndarray
+    de: np.ndarray
+    ue: np.ndarray
+    ve: np.ndarray
+    he: np.ndarray
+    fe: np.ndarray
+    ge: np.ndarray
+    stretch: np.ndarray
+
+
+@njit(cache=True, error_model="numpy")
 def _scratch(npts, nt, nb, nq):
-    """Work arrays of :func:`_element_response`."""
-    return (np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((9, 3)), np.empty((9, 3)),
-            np.empty((npts, nt, 3, 3)), np.empty((npts, nt, 9, 3)), np.empty((npts, nt, 9, 3)),
-            np.empty((npts, nt)), np.empty((npts, nt, 5)), np.empty((3, 3)), np.empty((3, 3)),
-            np.empty((3, 3)), np.empty((npts, nt, 2, 3)), np.empty((npts, nt, 3, 3)), np.empty((npts, 3)),
-            np.empty((npts, 3)), np.empty((npts, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
-            np.empty(5), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty((npts, nt, 2, 2)),
-            np.empty((npts, nt, 2)), np.empty((npts, nt, 2)), np.empty((npts, nt, 3)), np.empty(nb),
-            np.empty(nb), np.empty((nb, nb)), np.empty((nq, nt, 3, 3)), np.empty((nq, nt, 5)), np.empty((5, 5)),
-            np.empty((3, 3)), np.empty((nq, nt, 3, 3)), np.empty((8, 3, 3)))
+    """An :class:`ElementScratch` for ``npts`` in-plane points, ``nt`` layers, ``nb``
+    volumetric fields and ``nq`` Gauss points."""
+    return ElementScratch(
+        jac=np.empty((3, 3)), jinv=np.empty((3, 3)), q=np.empty((3, 3)), sg=np.empty((3, 3)), eg=np.empty((3, 3)),
+        F=np.empty((3, 3)), plane=np.empty((3, 3)), glob=np.empty((3, 3)), local=np.empty((3, 3)), v=np.empty((3, 3)),
+        gN=np.empty((9, 3)), gM=np.empty((9, 3)), s5=np.empty(5), cov=np.empty(3), delta=np.empty(3),
+        Ct=np.empty((5, 5)), Emean=np.empty((3, 3)), M3=np.empty((8, 3, 3)),
+        Q=np.empty((npts, nt, 3, 3)), jinv_all=np.empty((npts, nt, 3, 3)), GN=np.empty((npts, nt, 9, 3)),
+        GM=np.empty((npts, nt, 9, 3)), G=np.empty((npts, nt, 2, 3)), A=np.empty((npts, nt, 2, 2)),
+        DV=np.empty((npts, nt)), EPS=np.empty((npts, nt, 5)), cov_shear=np.empty((npts, nt, 2)),
+        TS=np.empty((npts, nt, 2)), SW=np.empty((npts, nt, 3)), cbar=np.empty((npts, 3)), Bab=np.empty((npts, 3)),
+        T=np.empty((npts, 3)), FP=np.empty((nq, nt, 3, 3)), LP=np.empty((nq, nt, 3, 3)), EPS0=np.empty((nq, nt, 5)),
+        coef=np.empty(nb), rhs=np.empty(nb), Mb=np.empty((nb, nb)),
+        xe=np.empty((9, 3)), de=np.empty((9, 3)), ue=np.empty((9, 3)), ve=np.empty((9, 3)), he=np.empty(9),
+        fe=np.empty((9, 3)), ge=np.empty((9, 3)), stretch=np.ones(nq))
 
 
-@njit(cache=True)
+class Assembly(NamedTuple):
+    """Per-element results before they are summed at the nodes (ne elements, n nodes):
+    fe, ge (ne, 9, 3) translational and director-conjugate forces; volume, stretch (ne,)
+    the element's volume and volume-weighted normal stretch (fibre-length update);
+    g (n, 3) the summed director-conjugate forces; weighted, weights (n,) the nodal
+    sums of stretch and volume. Allocated once per model (:func:`assembly`)."""
+
+    fe: np.ndarray
+    ge: np.ndarray
+    volume: np.ndarray
+    stretch: np.ndarray
+    g: np.ndarray
+    weighted: np.ndarray
+    weights: np.ndarray
+
+
+def element_chunks(n_elements: int) -> int:
+    """How many runs of elements the threads share out: one per thread (fewer on a tiny
+    mesh), each with its own scratch."""
+    return max(1, min(n_elements, get_num_threads()))
+
+
+def assembly(n_nodes: int, n_elements: int) -> Assembly:
+    """An :class:`Assembly` for a mesh of that size."""
+    return Assembly(fe=np.zeros((n_elements, 9, 3)), ge=np.zeros((n_elements, 9, 3)), volume=np.zeros(n_elements),
+                    stretch=np.zeros(n_elements), g=np.zeros((n_nodes, 3)), weighted=np.zeros(n_nodes),
+                    weights=np.zeros(n_nodes))
+
+
+@njit(cache=True, error_model="numpy")
 def _gather(nodes, x, d, h, xe, de, he):
     """Copy one element's positions, directors (9, 3) and fibre lengths (9,) from the
     nodal arrays."""
@@ -659,12 +743,16 @@ def _gather(nodes, x, d, h, xe, de, he):
             de[a, i] = d[node, i]
 
 
-@njit(cache=True)
-def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
-                  material, stress, state_stress, f, fr):
+@njit(cache=True, parallel=True, error_model="numpy")
+def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stress, f, fr, parts, chunks):
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
-    With Techniques 2 and 3 (INCREMENTAL mode, ``params[0]`` = 2 or 3), the fibre lengths
+    Elements are shared out in contiguous chunks over the threads; each writes only its
+    own slots of ``parts`` (:class:`Assembly`) and of ``stress`` (ne, nq, nt, 5), and the
+    nodes then add their elements' slots in ascending element order, so the sums are the
+    same to the last bit for any number of threads (and the same as a serial loop's).
+
+    With Techniques 2 and 3 (INCREMENTAL mode), the fibre lengths
     are scaled each step by 1 + the step's normal strain increment (thesis Eq 3.33); with
     a hyperelastic law in TOTAL mode the initial ones by the normal stretch, h = h0
     lambda_3 (thesis 3.11), one step behind the kinematics as in the thesis. Either factor
@@ -677,93 +765,105 @@ def _all_elements(mode, x, d, h, e1, ux, ud, conn, N, dNr, dNs, tie, tie_points,
     them and feeds back into lambda_3 (a loop no energy stands behind, which broke Test 10
     down). The updated h moves the faces (pressure, probes), masses and volume.
     """
-    law, params, axes0, h0, thickness_update = material
-    hyper = law != hyperelastic.LINEAR
-    nn = x.shape[0]
-    nq = wq.shape[0]
-    f[:] = 0.0
-    g = np.zeros((nn, 3))
-    work = _scratch(N.shape[0], tz.shape[0], vol_basis.shape[1], nq)
-    DV = work[8]
-    xe = np.empty((9, 3))
-    de = np.empty((9, 3))
-    he = np.empty(9)
-    ue = np.empty((9, 3))
-    ve = np.empty((9, 3))
-    fe = np.empty((9, 3))
-    ge = np.empty((9, 3))
-    stretch = np.ones(nq)
+    h0, h = body.h0, shape.h
+    hyper = material.law != hyperelastic.LINEAR
+    ne = body.conn.shape[0]
     # Technique 1 sets h = h0 lambda_3 (total), Techniques 2 and 3 scale h by each step's
     # 1 + normal strain increment (incremental, thesis Eq 3.33)
-    incremental_update = (not hyper) and params[0] > 0.0 and mode == INCREMENTAL
-    update = thickness_update and ((hyper and mode == TOTAL) or incremental_update)
-    weighted = np.zeros(nn if update else 0)
-    weights = np.zeros(nn if update else 0)
-    for e in range(conn.shape[0]):
-        _gather(conn[e], x, d, h0 if hyper else h, xe, de, he)
+    incremental_update = material.technique >= 2 and mode == INCREMENTAL
+    update = material.thickness_update and ((hyper and mode == TOTAL) or incremental_update)
+    for c in prange(chunks):
+        _element_chunk(c * ne // chunks, (c + 1) * ne // chunks, mode, rule, body, material, shape, ux, ud, stress,
+                       state_stress, parts, update)
+    _gather_at_nodes(body, parts, update, f)
+    to_rotational(parts.g, shape.d, shape.e1, fr)
+    if update:
+        for node in range(h.shape[0]):
+            if parts.weights[node] > 0.0:
+                h[node] = (h[node] if incremental_update else h0[node]) * parts.weighted[node] / parts.weights[node]
+
+
+@njit(cache=True, error_model="numpy")
+def _element_chunk(start, stop, mode, rule, body, material, shape, ux, ud, stress, state_stress, parts, update):
+    """The responses of elements start..stop-1 into their slots of ``parts`` and
+    ``stress``; arguments as :func:`_all_elements`, ``update``: whether the fibre lengths
+    follow (element volumes and mean stretches are then kept)."""
+    conn = body.conn
+    hyper = material.law != hyperelastic.LINEAR
+    nq = rule.wq.shape[0]
+    nt = rule.tz.shape[0]
+    work = _scratch(rule.N.shape[0], nt, rule.vol_basis.shape[1], nq)
+    for e in range(start, stop):
+        _gather(conn[e], shape.x, shape.d, body.h0 if hyper else shape.h, work.xe, work.de, work.he)
         for a in range(9):
             for i in range(3):
-                ue[a, i] = ux[conn[e, a], i]
-                ve[a, i] = ud[conn[e, a], i]
-        _element_response(mode, xe, de, he, ue, ve, jac0_inv[e], N, dNr, dNs, tie, tie_points, wq, tz, wt, C, vol_basis,
-                          law, params, axes0[e if hyper else 0], stress[e], state_stress[e], stretch, fe, ge, work)
-        for a in range(9):
-            node = conn[e, a]
-            for i in range(3):
-                f[node, i] += fe[a, i]
-                g[node, i] += ge[a, i]
+                work.ue[a, i] = ux[conn[e, a], i]
+                work.ve[a, i] = ud[conn[e, a], i]
+        _element_response(mode, work.xe, work.de, work.he, work.ue, work.ve, body.jac0_inv[e], rule, material,
+                          material.axes0[e if hyper else 0], stress[e], state_stress[e], work.stretch, parts.fe[e],
+                          parts.ge[e], work)
         if update:
             vol = 0.0
             mean = 0.0
             for p in range(nq):
                 dv = 0.0
-                for k in range(tz.shape[0]):
-                    dv += DV[p, k]
+                for k in range(nt):
+                    dv += work.DV[p, k]
                 vol += dv
-                mean += dv * stretch[p]
-            for a in range(9):
-                weighted[conn[e, a]] += mean
-                weights[conn[e, a]] += vol
-    _to_rotational(g, d, e1, fr)
-    if update:
-        for node in range(nn):
-            if weights[node] > 0.0:
-                h[node] = (h[node] if incremental_update else h0[node]) * weighted[node] / weights[node]
+                mean += dv * work.stretch[p]
+            parts.volume[e] = vol
+            parts.stretch[e] = mean
 
 
-@njit(cache=True)
-def internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material,
-                    incremental, dx, dd, stress, f, fr):
+@njit(cache=True, error_model="numpy")
+def _gather_at_nodes(body, parts, update, f):
+    """The nodal sums of ``parts`` (:class:`Assembly`), each node's slots in ascending
+    order: f (n, 3) from fe, parts.g from ge, and (``update``) parts.weighted and
+    parts.weights from the elements' stretch and volume."""
+    g = parts.g
+    for node in range(g.shape[0]):
+        f[node, :] = 0.0
+        g[node, :] = 0.0
+        weighted = 0.0
+        weights = 0.0
+        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
+            e, a = divmod(body.slots[slot], 9)
+            for i in range(3):
+                f[node, i] += parts.fe[e, a, i]
+                g[node, i] += parts.ge[e, a, i]
+            if update:
+                weighted += parts.stretch[e]
+                weights += parts.volume[e]
+        parts.weighted[node] = weighted
+        parts.weights[node] = weights
+
+
+@njit(cache=True, error_model="numpy")
+def internal_forces(rule, body, material, shape, dx, dd, stress, f, fr, parts, chunks):
     """Internal forces of all elements at the current configuration.
 
     Parameters
     ----------
-    x, d : (n, 3) current mid-surface positions and unit directors.
-    h : (n,) fibre lengths (updated in place when the material asks for it, see below).
-    e1 : (n, 3) fibre-frame first axes.
-    conn : (ne, 9). N, dNr, dNs : (npts, 9) shape functions and derivatives at the 3 x 3
-        integration points and the membrane tying points; tie, tie_points: the tying
-        interpolation (:func:`shellsim.model.integration_rule`); wq (nq,).
-        tz, wt : (nt,) thickness points and weights.
-    jac0_inv : (ne, npts, nt, 3, 3) inverse reference Jacobians.
-    C : (5, 5) reduced lamina constitutive matrix (small-strain law).
-    material : (law, params (4,), axes0 (ne, nq, nt, 3, 3), h0 (n,), thickness_update):
-        the hyperelastic law of :mod:`shellsim.materials.hyperelastic` (LINEAR: use C),
-        its initial material frames, and the fibre-length update (h = h0 lambda_3).
-    incremental : False for the total formulation (stress from the total deformation,
-        Almansi strain, thesis Eq 3.1 and 3.22); True for the incremental one (stress
-        in the lamina frame plus C~ times the strain increment of the last step, Eq 3.2).
+    rule, body, material : :class:`shellsim.bundles.Rule`, :class:`~shellsim.bundles.Body`,
+        :class:`~shellsim.bundles.Material`. In the total formulation the stress follows
+        from the total deformation (Almansi strain, thesis Eq 3.1 and 3.22); in the
+        incremental one (``material.incremental``) the stress in the lamina frame gains
+        C~ times the strain increment of the last step (Eq 3.2).
+    shape : :class:`~shellsim.bundles.Shape`, the current configuration; its fibre lengths
+        h are updated in place when the material asks (see :func:`_all_elements`).
     dx, dd : (n, 3) last step's mid-surface and director increments (incremental only).
     stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
+    parts : :class:`Assembly` of the mesh (scratch).
+    chunks : how many contiguous runs of elements the threads share out (see
+        :func:`element_chunks`); the results do not depend on it.
     """
-    _all_elements(INCREMENTAL if incremental else TOTAL, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie,
-                  tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, stress, stress, f, fr)
+    _all_elements(INCREMENTAL if material.incremental else TOTAL, rule, body, material, shape, dx, dd, stress, stress,
+                  f, fr, parts, chunks)
 
 
-@njit(cache=True)
-def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material,
-                      stress, vu, vr, f, fr):
+@njit(cache=True, error_model="numpy")
+def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, chunks):
     """Tangent stiffness times a DOF vector, K v, without forming K: the material part
     K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
     Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
@@ -773,16 +873,20 @@ def stiffness_product(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, w
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
     fr (n, 2). Other arguments as :func:`internal_forces`.
     """
+    x = shape.x
     vd = np.empty((x.shape[0], 3))
-    director_increments(vr, d, e1, vd)
-    field_stress = np.empty((conn.shape[0], wq.shape[0], tz.shape[0], 5))
-    _all_elements(LINEAR, x, d, h, e1, vu, vd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis,
-                  material, field_stress, stress, f, fr)
+    director_increments(vr, shape.d, shape.e1, vd)
+    ne = body.conn.shape[0]
+    field_stress = np.empty((ne, rule.wq.shape[0], rule.tz.shape[0], 5))
+    parts = Assembly(fe=np.empty((ne, 9, 3)), ge=np.empty((ne, 9, 3)), volume=np.empty(ne), stretch=np.empty(ne),
+                     g=np.empty((x.shape[0], 3)), weighted=np.empty(x.shape[0]), weights=np.empty(x.shape[0]))
+    _all_elements(LINEAR, rule, body, material, shape, vu, vd, field_stress, stress, f, fr, parts, chunks)
 
 
-@njit(cache=True)
-def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, mr):
-    """Lumped nodal masses on the current configuration (thesis 3.14).
+@njit(cache=True, error_model="numpy")
+def lumped_masses(rule, body, shape, density, hughes, mt, mr):
+    """Lumped nodal masses on the current ``shape`` (thesis 3.14); rule, body: the
+    element's :class:`~shellsim.bundles.Rule` and the mesh's :class:`~shellsim.bundles.Body`.
 
     hughes=True gives M1 (Hughes et al. 1981): translational masses proportional to
     int N_a^2 rho dV, scaled to the element mass; rotational ones are those times
@@ -792,6 +896,8 @@ def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, m
     the thickness: the 2- and 3-point rules give that anyway, and the 1-point rule of a
     membrane-only scene would give no rotary inertia at all). Writes mt (n,) and mr (n,).
     """
+    x, d, h, conn = shape.x, shape.d, shape.h, body.conn
+    N, dNr, dNs, wq, tz, wt = rule.N, rule.dNr, rule.dNs, rule.wq, rule.tz, rule.wt
     mt[:] = 0.0
     mr[:] = 0.0
     jac = np.empty((3, 3))
@@ -835,78 +941,3 @@ def lumped_masses(x, d, h, conn, N, dNr, dNs, wq, tz, wt, density, hughes, mt, m
         for a in range(9):
             mt[conn[e, a]] += raw[a]
             mr[conn[e, a]] += rot[a]
-
-
-@njit(cache=True)
-def pressure_forces(x, d, h, conn, elements, face, scale, N, dNr, dNs, wq, f, g):
-    """Follower pressure on faces of ``elements`` (m,), thesis 3.12.1: adds to f, g (n, 3).
-
-    face (m,): -1 bottom (t = -1), 0 mid-surface, +1 top. scale (m,): the current pressure;
-    positive pushes into the shell, i.e. along +n on the bottom face and the mid-surface
-    and along -n on the top face, n = g_r x g_s / |.| (the directors' side). Forces act
-    where the face is, so the director-conjugate part g carries their lever arm.
-    """
-    yr = np.empty(3)
-    ys = np.empty(3)
-    area = np.empty(3)
-    for m in range(elements.shape[0]):
-        e = elements[m]
-        t = float(face[m])
-        sign = -1.0 if face[m] > 0 else 1.0
-        for p in range(wq.shape[0]):
-            yr[:] = 0.0
-            ys[:] = 0.0
-            for a in range(9):
-                node = conn[e, a]
-                for i in range(3):
-                    pos = x[node, i] + t * 0.5 * h[node] * d[node, i]
-                    yr[i] += dNr[p, a] * pos
-                    ys[i] += dNs[p, a] * pos
-            area[0] = yr[1] * ys[2] - yr[2] * ys[1]
-            area[1] = yr[2] * ys[0] - yr[0] * ys[2]
-            area[2] = yr[0] * ys[1] - yr[1] * ys[0]
-            for a in range(9):
-                node = conn[e, a]
-                w = sign * scale[m] * N[p, a] * wq[p]
-                for i in range(3):
-                    f[node, i] += w * area[i]
-                    g[node, i] += w * area[i] * t * 0.5 * h[node]
-
-
-#: 3-point Gauss rule along an element edge and the 1D quadratic shape functions at its
-#: points, for (corner, mid-side, corner) node triples.
-EDGE_XI = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
-EDGE_W = np.array([5.0, 8.0, 5.0]) / 9.0
-EDGE_N = np.stack([EDGE_XI * (EDGE_XI - 1) / 2, 1 - EDGE_XI**2, EDGE_XI * (EDGE_XI + 1) / 2], axis=1)
-EDGE_DN = np.stack([EDGE_XI - 0.5, -2 * EDGE_XI, EDGE_XI + 0.5], axis=1)
-
-
-@njit(cache=True)
-def edge_pressure_forces(x, d, h, edges, outward, scale, f):
-    """Pressure on the shell's edge faces (force per unit edge length = p times the fibre
-    length), normal to the edge within the shell, pushing in. Adds to f (n, 3).
-
-    edges (m, 3) node triples; outward (m,) +1 or -1, the sign that makes
-    tangent x director point out of the shell; scale (m,) the current pressure.
-    """
-    for m in range(edges.shape[0]):
-        for p in range(3):
-            tan = np.zeros(3)
-            nrm = np.zeros(3)
-            thick = 0.0
-            for k in range(3):
-                node = edges[m, k]
-                thick += EDGE_N[p, k] * h[node]
-                for i in range(3):
-                    tan[i] += EDGE_DN[p, k] * x[node, i]
-                    nrm[i] += EDGE_N[p, k] * d[node, i]
-            nrm /= np.sqrt(nrm @ nrm)
-            out = np.empty(3)
-            out[0] = tan[1] * nrm[2] - tan[2] * nrm[1]
-            out[1] = tan[2] * nrm[0] - tan[0] * nrm[2]
-            out[2] = tan[0] * nrm[1] - tan[1] * nrm[0]
-            for k in range(3):
-                node = edges[m, k]
-                w = -outward[m] * scale[m] * thick * EDGE_N[p, k] * EDGE_W[p]
-                for i in range(3):
-                    f[node, i] += w * out[i]

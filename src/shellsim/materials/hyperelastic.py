@@ -46,7 +46,7 @@ from ..tensor3 import congruence
 LINEAR, MOONEY_RIVLIN, GUCCIONE, ST_VENANT_KIRCHHOFF = -1, 0, 1, 2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _guccione_weight(params, i, j):
     """Guccione's b_ij from params (C1, C2, C3, C4): C2 along the fibre (11), C4 for the
     fibre shears (12, 13), C3 for the rest."""
@@ -57,7 +57,7 @@ def _guccione_weight(params, i, j):
     return params[2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _guccione_exponent(params, E):
     """Q = sum_ij b_ij E_ij^2 of E (3, 3)."""
     Q = 0.0
@@ -67,7 +67,7 @@ def _guccione_exponent(params, E):
     return Q
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def strain_energy(law, params, E):
     """W (per unit initial volume) of the full strain E (3, 3); the constraint is not
     applied here (tests use it to check the stresses)."""
@@ -91,7 +91,7 @@ def strain_energy(law, params, E):
     return params[0] * (I1 - 3.0) + params[1] * (I2 - 3.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _energy_stress(law, params, E, S):
     """S^w = dW/dE (3, 3) at E, without the constraint's pressure."""
     if law == GUCCIONE:
@@ -110,7 +110,7 @@ def _energy_stress(law, params, E, S):
         S[i, i] += 2.0 * (params[0] + params[1] * I1)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _energy_tangent(law, params, E, dE, dS):
     """dS^w = CC^w : dE (3, 3), the directional derivative of :func:`_energy_stress`."""
     if law == GUCCIONE:
@@ -133,7 +133,7 @@ def _energy_tangent(law, params, E, dE, dS):
         dS[i, i] += 4.0 * params[1] * trace
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _svk(params, E, S):
     """S = lambda tr E I + 2 mu E, transverse shears times kappa (linear in E)."""
     lam, mu, kappa = params[0], params[1], params[2]
@@ -145,7 +145,7 @@ def _svk(params, E, S):
         S[i, i] += lam * trace
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def normal_strain(law, params, E):
     """Set E[2, 2] for zero normal stress: from J = 1 for the incompressible laws, from
     S33 = 0 for St. Venant-Kirchhoff. Returns the normal stretch sqrt(1 + 2 E33)."""
@@ -155,7 +155,7 @@ def normal_strain(law, params, E):
     return solve_normal_strain(E, 1.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def volume_ratio(law, E):
     """J = sqrt(det(2E + I)) of a solved strain: 1 for the incompressible laws (the
     constraint made it so), computed for St. Venant-Kirchhoff."""
@@ -166,7 +166,7 @@ def volume_ratio(law, E):
     return np.sqrt(c11 * (c22 * c33 - c23 * c23) - c12 * (c12 * c33 - c23 * c13) + c13 * (c12 * c23 - c22 * c13))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _inverse_stretch(E, out):
     """out = (2E + I)^-1 for a solved strain E (3, 3) of an incompressible law, whose
     determinant is 1: the inverse is the adjugate."""
@@ -180,7 +180,7 @@ def _inverse_stretch(E, out):
     out[1, 2] = out[2, 1] = c12 * c13 - c11 * c23
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def solve_normal_strain(E, J):
     """Set E[2, 2] so that det(2E + I) = J^2 (thesis Eq 3.28; J = 1: incompressible).
     det C = C33 (C11 C22 - C12^2) + (terms free of C33), so the solution is direct.
@@ -193,7 +193,7 @@ def solve_normal_strain(E, J):
     return np.sqrt(c33)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def stress(law, params, E, S, Cinv):
     """Second Piola stress S~ (3, 3) under zero normal stress, in the material frame.
 
@@ -217,7 +217,7 @@ def stress(law, params, E, S, Cinv):
     return p
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def tangent(law, params, E, Cinv, p, dE, dS):
     """dS~ (3, 3) for a strain direction dE (3, 3) at a solved state (E, Cinv, p from
     :func:`stress`). dE[2, 2] is overwritten by the constraint's value."""

@@ -101,8 +101,8 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
     thickness) of ``model``."""
     ne = model.n_elements
     if solid:
-        layers = -1.0 + np.concatenate([[0.0], np.cumsum(model.wt)])
-        bottom = (np.arange(len(model.wt))[:, None, None] * 16 + SUB_QUADS[None]).reshape(-1, 4)
+        layers = -1.0 + np.concatenate([[0.0], np.cumsum(model.rule.wt)])
+        bottom = (np.arange(len(model.rule.wt))[:, None, None] * 16 + SUB_QUADS[None]).reshape(-1, 4)
         local = np.hstack([bottom, bottom + 16])
     else:
         layers = np.zeros(1)
@@ -110,7 +110,7 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
     cells = (np.arange(ne)[:, None, None] * len(layers) * 16 + local[None]).reshape(-1, local.shape[1])
     points = _corner_points(model.x0, model.d0, model.h0, model.conn, layers)
     return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers,
-                      gauss_to_nodes=np.linalg.inv(model.N[:len(model.wq)]),
+                      gauss_to_nodes=np.linalg.inv(model.rule.N[:len(model.rule.wq)]),
                       elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes))
 
 
@@ -167,7 +167,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
         if mesh.solid:
             cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
         else:
-            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.wt, axis=2)
+            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
     return point_data, cell_data

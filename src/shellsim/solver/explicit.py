@@ -15,91 +15,80 @@ increments, kinetic energy of the half-step velocities, work of the damping forc
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-from ..deck.curves import curve_value
+from ..curve_tables import factor
 from ..element import kernels
 from ..element.frames import rotate_director
+from ..loads import external_forces
 
 #: Indices into the work and energy arrays: internal work, kinetic energy, external work,
 #: damping work.
 INTERNAL, KINETIC, EXTERNAL, DAMPED = range(4)
 
 
-@njit(cache=True)
-def _factor(index, time, curve_t, curve_v, curve_len, curve_interp, curve_extrap):
-    if index < 0:
-        return 1.0
-    n = curve_len[index]
-    return curve_value(curve_t[index, :n], curve_v[index, :n], curve_interp[index], curve_extrap[index], time)
+class Workspace(NamedTuple):
+    """Scratch of the time loop, allocated once per simulation (n nodes): dx, dd (n, 3)
+    the last step's mid-surface and director increments; g (n, 3) director-conjugate
+    external forces; scale_pressure (P,), scale_edges (E,) the current load values;
+    parts: the element results before assembly (:class:`shellsim.element.kernels.Assembly`);
+    chunks: runs of elements the threads share out (:func:`shellsim.element.kernels.element_chunks`)."""
+
+    dx: np.ndarray
+    dd: np.ndarray
+    g: np.ndarray
+    scale_pressure: np.ndarray
+    scale_edges: np.ndarray
+    parts: kernels.Assembly
+    chunks: int
+
+
+def workspace(model) -> Workspace:
+    """A :class:`Workspace` for ``model`` (:class:`shellsim.bundles.Model`)."""
+    n = model.x0.shape[0]
+    return Workspace(dx=np.zeros((n, 3)), dd=np.zeros((n, 3)), g=np.zeros((n, 3)),
+                     scale_pressure=np.zeros(len(model.loads.pressure.elements)),
+                     scale_edges=np.zeros(len(model.loads.edge_pressure.edges)),
+                     parts=kernels.assembly(n, len(model.body.conn)), chunks=kernels.element_chunks(len(model.body.conn)))
 
 
 @njit(cache=True)
-def forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
-           dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
-           pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
-           curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext):
-    """Internal and external forces at time t: f_* (n, 3) translational, fr_* (n, 2)
-    rotational. See :func:`shellsim.element.kernels.internal_forces` for the arguments."""
-    kernels.internal_forces(x, d, h, e1, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental,
-                            dx, dd, stress, f_int, fr_int)
-    n = x.shape[0]
-    f_ext[:] = 0.0
-    g = np.zeros((n, 3))
-    for k in range(dead_force_curve.shape[0]):
-        c = _factor(dead_force_curve[k], t, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
-        for node in range(n):
-            for i in range(3):
-                f_ext[node, i] += c * dead_force[k, node, i]
-    # A moment M turns the director by M x d: its director-conjugate force is M x d.
-    for k in range(dead_moment_curve.shape[0]):
-        c = _factor(dead_moment_curve[k], t, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
-        for node in range(n):
-            mx, my, mz = c * dead_moment[k, node, 0], c * dead_moment[k, node, 1], c * dead_moment[k, node, 2]
-            g[node, 0] += my * d[node, 2] - mz * d[node, 1]
-            g[node, 1] += mz * d[node, 0] - mx * d[node, 2]
-            g[node, 2] += mx * d[node, 1] - my * d[node, 0]
-    if pressure_elements.shape[0]:
-        scale = np.empty(pressure_elements.shape[0])
-        for m in range(scale.shape[0]):
-            scale[m] = pressure_value[m] * _factor(pressure_curve[m], t, curve_t, curve_v, curve_len,
-                                                   curve_interp, curve_extrap)
-        kernels.pressure_forces(x, d, h, conn, pressure_elements, pressure_face, scale, N, dNr, dNs, wq, f_ext, g)
-    if edge_edges.shape[0]:
-        scale = np.empty(edge_edges.shape[0])
-        for m in range(scale.shape[0]):
-            scale[m] = edge_value[m] * _factor(edge_curve[m], t, curve_t, curve_v, curve_len,
-                                               curve_interp, curve_extrap)
-        kernels.edge_pressure_forces(x, d, h, edge_edges, edge_outward, scale, f_ext)
-    # Director-conjugate forces act on the rotational DOFs through the current fibre
-    # frame: -e1f.g, -e2f.g.
-    kernels._to_rotational(g, d, e1, fr_ext)
+def forces(t, model, fields, space):
+    """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
+    f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
+    forces of the incremental formulation take the last step's increments from ``space``."""
+    kernels.internal_forces(model.rule, model.body, model.material, fields.shape, space.dx, space.dd, fields.stress,
+                            fields.f_int, fields.fr_int, space.parts, space.chunks)
+    external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g, space.scale_pressure,
+                    space.scale_edges)
 
 
 @njit(cache=True)
-def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt, mr, projector,
-            rot_free, prescribed_nodes, prescribed_axes, prescribed_values, prescribed_curves,
-            prescribed_velocity, damping,
-            conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
-            dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
-            pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
-            curve_t, curve_v, curve_len, curve_interp, curve_extrap,
-            f_int, fr_int, f_ext, fr_ext, work, energy):
+def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     """Take central-difference steps of size ``dt`` until ``t_stop`` or ``max_steps``.
 
-    On entry the forces f_int, fr_int, f_ext, fr_ext must be those at time t; on return
-    they are those at the returned time. ``dt_prev`` is the previous step (0 before the
-    first step, which makes it the start-up half step). All state arrays are updated in
-    place. ``work`` (4,) accumulates internal, external and damping work to the current
-    time; ``energy`` (4,) is the balance at the start of the last step taken, whose
-    kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences conserve
-    exactly with the trapezoidal works (a linear undamped system keeps
+    model: :class:`shellsim.bundles.Model`; fields: :class:`shellsim.bundles.Fields`,
+    updated in place; space: a :class:`Workspace`. On entry the forces in ``fields``
+    must be those at time t; on return they are those at the returned time. ``dt_prev``
+    is the previous step (0 before the first step, which makes it the start-up half
+    step). ``fields.work`` (4,) accumulates internal, external and damping work to the
+    current time; ``fields.energy`` (4,) is the balance at the start of the last step
+    taken, whose kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences
+    conserve exactly with the trapezoidal works (a linear undamped system keeps
     internal + kinetic - external constant to round-off). Returns (t, dt_prev, steps).
     """
+    x, d, e1 = fields.shape.x, fields.shape.d, fields.shape.e1
+    v, w, theta, mt, mr = fields.v, fields.w, fields.theta, fields.mt, fields.mr
+    f_int, fr_int, f_ext, fr_ext = fields.f_int, fields.fr_int, fields.f_ext, fields.fr_ext
+    work, energy = fields.work, fields.energy
+    projector, rot_free, prescribed = model.constraints.projector, model.constraints.rot_free, model.constraints.prescribed
+    prescribed_velocity = fields.prescribed_velocity
+    damping = model.damping
+    dx, dd = space.dx, space.dd
     n = x.shape[0]
-    dx = np.zeros((n, 3))
-    dd = np.zeros((n, 3))
     d_old = np.empty(3)
     a = np.empty(3)
     steps = 0
@@ -127,10 +116,9 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
                                              + dt_avg * (fr_ext[node, j] - fr_int[node, j]) / mr[node]) / (1.0 + 0.5 * c)
                 kinetic += 0.5 * mr[node] * w[node, j] * w_new
                 w[node, j] = w_new
-        for p in range(prescribed_nodes.shape[0]):
-            node, i = prescribed_nodes[p], prescribed_axes[p]
-            target = x0[node, i] + prescribed_values[p] * _factor(
-                prescribed_curves[p], t + step, curve_t, curve_v, curve_len, curve_interp, curve_extrap)
+        for p in range(prescribed.nodes.shape[0]):
+            node, i = prescribed.nodes[p], prescribed.axes[p]
+            target = model.x0[node, i] + prescribed.values[p] * factor(model.curves, prescribed.curves[p], t + step)
             v_new = (target - x[node, i]) / step
             # the support's reaction (inertia less applied forces) works on the motion
             reaction = (mt[node] * (v_new - prescribed_velocity[p]) / dt_avg
@@ -162,10 +150,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, x, x0, d, e1, h, v, w, theta, mt,
                 work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
                 work_int += 0.5 * fr_int[node, j] * step * w[node, j]
         t += step
-        forces(t, x, d, h, e1, dx, dd, conn, N, dNr, dNs, tie, tie_points, wq, tz, wt, jac0_inv, C, vol_basis, material, incremental, stress,
-               dead_force, dead_force_curve, dead_moment, dead_moment_curve, pressure_elements, pressure_face, pressure_value,
-               pressure_curve, edge_edges, edge_outward, edge_value, edge_curve,
-               curve_t, curve_v, curve_len, curve_interp, curve_extrap, f_int, fr_int, f_ext, fr_ext)
+        forces(t, model, fields, space)
         damped = 0.0
         for node in range(n):
             for i in range(3):

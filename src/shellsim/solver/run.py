@@ -140,7 +140,7 @@ def probe_value(run: Run, probe: Probe) -> float:
     if probe.quantity in POINT_QUANTITIES:
         e, p = probe.element, probe.point
         _, cauchy, green = run.sim.point_tensors(slice(e, e + 1), slice(p, p + 1))
-        tensor = thickness_mean((green if probe.quantity == "strain" else cauchy)[0, 0], m.wt, axis=0)
+        tensor = thickness_mean((green if probe.quantity == "strain" else cauchy)[0, 0], m.rule.wt, axis=0)
         if probe.quantity == "pressure_band":
             return float(pressure_band(tensor))
         return float(tensor[TENSOR_COMPONENTS[probe.component]])
@@ -166,7 +166,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     for p in deck.output.probe:
         nodes = mesh.sets[p.set].nodes
         if p.quantity in POINT_QUANTITIES:
-            element, point = nearest_integration_point(model.x0, model.conn, model.N[:len(model.wq)],
+            element, point = nearest_integration_point(model.x0, model.conn, model.rule.N[:len(model.rule.wq)],
                                                        model.x0[nodes].mean(axis=0))
             probes.append(Probe(p.name, p.quantity, p.component, nodes, element, point))
             continue

@@ -28,15 +28,16 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
     inv_sqrt_t = 1.0 / np.sqrt(s.mt)
     inv_sqrt_r = 1.0 / np.sqrt(s.mr)
     fu, fr = np.empty((n, 3)), np.empty((n, 2))
+    projector, rot_free = m.constraints.projector, m.constraints.rot_free
+    chunks = kernels.element_chunks(m.n_elements)
 
     def apply(z: np.ndarray) -> np.ndarray:
         z = np.asarray(z).ravel()
-        vu = np.einsum("nij,nj->ni", m.projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
-        vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * m.rot_free
-        kernels.stiffness_product(s.x, s.d, s.h, s.e1, m.conn, m.N, m.dNr, m.dNs, m.tie, m.tie_points, m.wq, m.tz, m.wt,
-                                  m.jac0_inv, m.C, m.vol_basis, m.material, s.stress, vu, vr, fu, fr)
-        out_u = np.einsum("nij,nj->ni", m.projector, fu) * inv_sqrt_t[:, None]
-        out_r = fr * m.rot_free * inv_sqrt_r[:, None]
+        vu = np.einsum("nij,nj->ni", projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
+        vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * rot_free
+        kernels.stiffness_product(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, chunks)
+        out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
+        out_r = fr * rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])
 
     size = 5 * n

@@ -70,11 +70,12 @@ def open_client(scheduler: str | None, workers: int | None = None):
                   dashboard_address=None)
 
 
-def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None]) -> None:
-    """Submit every job to ``client`` and call ``on_row`` with each row as it finishes."""
+def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None], threads: int | None = None) -> None:
+    """Submit every job to ``client`` and call ``on_row`` with each row as it finishes;
+    ``threads``: the kernels' threads in each job (None: the worker's default)."""
     from dask.distributed import as_completed
 
-    futures = {client.submit(run_job, job, key=f"shellsim-{i}-{job.key}", pure=False): job
+    futures = {client.submit(run_job_on_threads, job, threads, key=f"shellsim-{i}-{job.key}", pure=False): job
                for i, job in enumerate(jobs)}
     for future in as_completed(futures):
         job = futures[future]
@@ -82,6 +83,16 @@ def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None]) -> None:
             on_row(failed_row(job, future.exception()))
         else:
             on_row(future.result())
+
+
+def run_job_on_threads(job: Job, threads: int | None) -> dict:
+    """:func:`run_job` with the kernels on ``threads`` threads (numba's setting is per
+    calling thread, so it is made in the thread that runs the job)."""
+    if threads is not None:
+        import numba
+
+        numba.set_num_threads(threads)
+    return run_job(job)
 
 
 def rows_in_order(jobs: list[Job], rows: list[dict]) -> Iterator[dict]:

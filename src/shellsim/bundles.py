@@ -1,0 +1,228 @@
+"""The named bundles the compiled layer receives: typed tuples of arrays, built once by
+:func:`shellsim.model.build_model` (the scene) or :class:`shellsim.solver.simulation.Simulation`
+(the state), and passed whole to every compiled function.
+
+numba compiles a ``NamedTuple`` into a struct whose fields are read by name, and its
+on-disk cache keeps working across processes, so no compiled function depends on the
+order of a long argument list. Shapes: n nodes, ne elements, npts = 25 points of the
+in-plane rule (9 Gauss points, then the 16 membrane tying points), nq = 9 Gauss points,
+nt points through the thickness.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class Rule(NamedTuple):
+    """The element's integration and assumed-strain rule (:func:`shellsim.model.integration_rule`).
+
+    N, dNr, dNs (npts, 9): shape functions and their derivatives at the points; tie
+    (3, nq, 6), tie_points (3, 6): the tying interpolation of the covariant membrane
+    strains rr, ss, rs; wq (nq,): in-plane weights; tz, wt (nt,): thickness points and
+    weights; vol_basis (nq, nb): fields the in-plane volumetric strain is projected on
+    (plane strain: 1, r, s; otherwise nb = 0).
+    """
+
+    N: np.ndarray
+    dNr: np.ndarray
+    dNs: np.ndarray
+    tie: np.ndarray
+    tie_points: np.ndarray
+    wq: np.ndarray
+    tz: np.ndarray
+    wt: np.ndarray
+    vol_basis: np.ndarray
+
+
+class Body(NamedTuple):
+    """The mesh as the kernels see it: conn (ne, 9) node numbers; jac0_inv
+    (ne, npts, nt, 3, 3) inverse initial Jacobians dX/d(r, s, t)^-1; h0 (n,) initial
+    fibre lengths [length]; node_slots (n + 1,) and slots (ne * 9,): for each node, the
+    element slots e * 9 + a that hold it, in ascending order (node k's are
+    slots[node_slots[k]:node_slots[k + 1]]), so nodal sums of element values are taken
+    in one fixed order whatever the number of threads."""
+
+    conn: np.ndarray
+    jac0_inv: np.ndarray
+    h0: np.ndarray
+    node_slots: np.ndarray
+    slots: np.ndarray
+
+
+class Material(NamedTuple):
+    """The constitutive path.
+
+    law: a code of :mod:`shellsim.materials.hyperelastic` (LINEAR: the constant tensor C);
+    params (4,): the law's parameters; C (5, 5): reduced lamina matrix of the constant
+    tensor [stress]; axes0 (ne, nq, nt, 3, 3) initial material frames of a hyperelastic
+    law (rows a1, a2, a3; (1, ...) unused otherwise); technique: 0 small strain, 1, 2 or 3
+    (thesis 3.10); normal_ratio: nu / (1 - nu), the normal strain increment per in-plane
+    one of Techniques 2 and 3; incremental: stress accumulated from strain increments
+    (thesis Eq 3.2) instead of computed from the total strain; thickness_update: the
+    fibre lengths follow the normal stretch (thesis 3.11).
+    """
+
+    law: int
+    params: np.ndarray
+    C: np.ndarray
+    axes0: np.ndarray
+    technique: int
+    normal_ratio: float
+    incremental: bool
+    thickness_update: bool
+
+
+class Curves(NamedTuple):
+    """Time curves as padded tables: t, v (C, K) times and factors; length (C,) points
+    used; interp, extrap (C,) codes of :mod:`shellsim.curve_tables`."""
+
+    t: np.ndarray
+    v: np.ndarray
+    length: np.ndarray
+    interp: np.ndarray
+    extrap: np.ndarray
+
+
+class NodalLoads(NamedTuple):
+    """Dead nodal vectors (forces or moments): vectors (L, n, 3), each scaled by its curve
+    (L,) (index into :class:`Curves`, -1 constant)."""
+
+    vectors: np.ndarray
+    curve: np.ndarray
+
+
+class PressureLoads(NamedTuple):
+    """Follower pressure on element faces (P,): elements, face (-1 bottom, 0 mid, +1 top),
+    value [force/length^2], curve."""
+
+    elements: np.ndarray
+    face: np.ndarray
+    value: np.ndarray
+    curve: np.ndarray
+
+
+class EdgePressureLoads(NamedTuple):
+    """Pressure on edge faces (E,): edges (E, 3) node triples, outward (+1 or -1, the sign
+    that makes tangent x director point out), value [force/length^2], curve."""
+
+    edges: np.ndarray
+    outward: np.ndarray
+    value: np.ndarray
+    curve: np.ndarray
+
+
+class Loads(NamedTuple):
+    """Every external load of a scene, by kind."""
+
+    force: NodalLoads
+    moment: NodalLoads
+    pressure: PressureLoads
+    edge_pressure: EdgePressureLoads
+
+
+class Prescribed(NamedTuple):
+    """Prescribed translations (P,): x[node, axis] = x0 + value * curve(t)."""
+
+    nodes: np.ndarray
+    axes: np.ndarray
+    values: np.ndarray
+    curves: np.ndarray
+
+
+class Constraints(NamedTuple):
+    """Supports as velocity projections: projector (n, 3, 3) onto the allowed
+    translational velocities; rot_free (n, 2): 1 free, 0 fixed rotational DOF;
+    prescribed translations."""
+
+    projector: np.ndarray
+    rot_free: np.ndarray
+    prescribed: Prescribed
+
+
+class Model(NamedTuple):
+    """A scene as the compiled layer sees it (:func:`shellsim.model.build_model`): its
+    rule, mesh, material, loads, curves and supports, and the initial shape (n nodes):
+    x0, d0 (n, 3) mid-surface and directors, e1f0 (n, 3) fibre-frame first axes;
+    density [mass/length^3]; mass 'M1' or 'M2' (thesis 3.14); damping [1/s]
+    (mass-proportional)."""
+
+    rule: Rule
+    body: Body
+    material: Material
+    loads: Loads
+    curves: Curves
+    constraints: Constraints
+    x0: np.ndarray
+    d0: np.ndarray
+    e1f0: np.ndarray
+    density: float
+    mass: str
+    damping: float
+
+    @property
+    def h0(self) -> np.ndarray:
+        """(n,) initial fibre lengths."""
+        return self.body.h0
+
+    @property
+    def conn(self) -> np.ndarray:
+        """(ne, 9) node numbers of each element."""
+        return self.body.conn
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.x0)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.body.conn)
+
+
+class Shape(NamedTuple):
+    """The shell's current shape: x, d (n, 3) mid-surface and unit directors; e1 (n, 3)
+    fibre-frame first axes; h (n,) fibre lengths (updated in place when the material asks)."""
+
+    x: np.ndarray
+    d: np.ndarray
+    e1: np.ndarray
+    h: np.ndarray
+
+
+class Fields(NamedTuple):
+    """The state's arrays, updated in place by the time loop (n nodes, ne elements,
+    nq x nt integration points): the current shape; v (n, 3), w (n, 2) translational and
+    rotational velocities at the last half step; theta (n, 2) accumulated rotations;
+    mt, mr (n,) lumped masses; stress (ne, nq, nt, 5) lamina Cauchy stress (s11, s22,
+    s12, s13, s23); f_int, f_ext (n, 3), fr_int, fr_ext (n, 2) forces at t;
+    prescribed_velocity (P,) of the prescribed translations; work (4,) internal,
+    (unused), external and damping work to t; energy (4,) internal work, kinetic energy,
+    external work, damping work at the start of the last step (see
+    :func:`shellsim.solver.explicit.advance`)."""
+
+    shape: Shape
+    v: np.ndarray
+    w: np.ndarray
+    theta: np.ndarray
+    mt: np.ndarray
+    mr: np.ndarray
+    stress: np.ndarray
+    f_int: np.ndarray
+    fr_int: np.ndarray
+    f_ext: np.ndarray
+    fr_ext: np.ndarray
+    prescribed_velocity: np.ndarray
+    work: np.ndarray
+    energy: np.ndarray
+
+
+def slots_by_node(conn: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """(node_slots (n + 1,), slots (ne * 9,)) of :class:`Body`: the element slots
+    e * 9 + a of each node in ascending order, as compressed rows."""
+    flat = conn.ravel()
+    slots = np.argsort(flat, kind="stable").astype(np.int64)
+    node_slots = np.zeros(n_nodes + 1, dtype=np.int64)
+    np.cumsum(np.bincount(flat, minlength=n_nodes), out=node_slots[1:])
+    return node_slots, slots

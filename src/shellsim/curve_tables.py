@@ -1,0 +1,42 @@
+"""Time curves evaluated from their tables, compiled: the deck's :class:`~shellsim.deck.curves.Curve`
+and the time loop read factors through the same function."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Codes of a table's interpolation and extrapolation.
+INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2}
+EXTRAPOLATION = {"constant": 0, "linear": 1}
+
+
+@njit(cache=True)
+def curve_value(t: np.ndarray, v: np.ndarray, interpolate: int, extrapolate: int, time: float) -> float:
+    """A curve's factor at ``time`` from its table t, v (K,); codes as in INTERPOLATION and
+    EXTRAPOLATION."""
+    n = t.shape[0]
+    if n == 1:
+        return v[0]
+    if time <= t[0] or time >= t[n - 1]:
+        i = 0 if time <= t[0] else n - 2
+        if extrapolate == 1:
+            return v[i] + (time - t[i]) / (t[i + 1] - t[i]) * (v[i + 1] - v[i])
+        return v[0] if time <= t[0] else v[n - 1]
+    i = np.searchsorted(t, time, side="right") - 1
+    u = (time - t[i]) / (t[i + 1] - t[i])
+    if interpolate == 1:
+        return v[i]
+    if interpolate == 2:
+        u = u * u * (3.0 - 2.0 * u)
+    return v[i] + u * (v[i + 1] - v[i])
+
+
+@njit(cache=True)
+def factor(curves, index, time):
+    """Factor of curve ``index`` of the tables ``curves`` (:class:`shellsim.bundles.Curves`)
+    at ``time``; 1 for index -1 (a constant load)."""
+    if index < 0:
+        return 1.0
+    n = curves.length[index]
+    return curve_value(curves.t[index, :n], curves.v[index, :n], curves.interp[index], curves.extrap[index], time)

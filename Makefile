@@ -19,8 +19,10 @@ $(STAMP): pyproject.toml
 run: $(STAMP)
 	$(BIN)/shellsim run $(DECK) --out $(OUT)
 
-# One test process per core (pytest-xdist); the numba cache is compiled once, before them.
+# The linter, then one test process per core (pytest-xdist); the numba cache is compiled
+# once, before them.
 test: $(STAMP)
+	$(BIN)/ruff check src tests benchmarks
 	$(BIN)/python -m pytest -q -n auto
 
 # The slow tests, then the verification and stability studies (the stability checks

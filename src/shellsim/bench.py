@@ -1,20 +1,26 @@
-"""Speed, measured: the element kernel on the Scordelis-Lo 16 x 16 mesh (microseconds per
-element per step, GFLOP/s from the operation count below), the cost of each constitutive
-path on one scene, and the peer-comparison plate (decks/bench/plate_step.toml) on a ladder
-of meshes (error of the first peak, wall time). Nothing here asserts a time; it reports."""
+"""Speed, measured: every constitutive path on the Scordelis-Lo 16 x 16 mesh on one thread
+and on every core (microseconds per element per step; GFLOP/s from the operation count
+below, against a one-thread matrix product), and the peer-comparison plate
+(decks/bench/plate_step.toml) on a ladder of meshes (error of the first peak, wall time).
+Nothing here asserts a time; it reports."""
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
 import tomllib
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from .deck import deck_from_data, parse_deck
 from .geometry import build_mesh
 from .model import build_model
-from .solver.run import integrate, prepare
+from .execute import built_run
+from .solver.run import integrate
 from .solver.simulation import Simulation
 from .verify.check import check
 
@@ -43,16 +49,58 @@ def flops_per_element(n_thick: int = 2) -> int:
     return points * (560 + 195 + 252 + 32 + 432) + integration * (305 + 228 + 59 + 68) + 9 * (36 + 39)
 
 
-def kernel_speed(divisions: int = 16, steps: int = 200) -> dict:
-    """Microseconds per element per step of the full time step (forces, update) on the
-    Scordelis-Lo roof with ``divisions`` x ``divisions`` elements."""
-    text = (DECKS / "verification" / "test05_scordelis_lo_6x6.toml").read_text()
-    deck = parse_deck(text.replace("around = 6, along = 6", f"around = {divisions}, along = {divisions}"))
-    sim = Simulation(build_model(deck, build_mesh(deck)))
-    us = _us_per_element_step(sim, steps, 1.25)
-    flops = flops_per_element(len(sim.model.rule.tz))
-    return {"elements": sim.model.n_elements, "steps": steps, "us_per_element_step": us,
-            "flops_per_element_step": flops, "gflops": flops / (us * 1e3)}
+#: Materials of the hyperelastic paths, as stiff as the roof's E = 4.32e8 at small strain
+#: (Mooney-Rivlin: E = 6 (C1 + C2); Guccione: about C1 C2 along the fibre).
+MOONEY_RIVLIN = {"model": "mooney_rivlin", "C1": 5.76e7, "C2": 1.44e7, "density": 36.7}
+GUCCIONE = {"model": "guccione", "C1": 4.32e7, "C2": 10.0, "C3": 5.0, "C4": 5.0, "density": 36.7,
+            "axes": {"kind": "fixed", "direction": [0.0, 1.0, 0.0]}}
+#: Constitutive paths measured by :func:`path_speeds`: (label, [material] table or None for
+#: the roof's own linear elastic one, [section] keys).
+PATHS = [
+    ("small strain (linear elastic)", None, {}),
+    ("Technique 1, St. Venant-Kirchhoff", None, {"technique": 1}),
+    ("Technique 1, Mooney-Rivlin", MOONEY_RIVLIN, {"technique": 1}),
+    ("Technique 1, Mooney-Rivlin, no thickness update", MOONEY_RIVLIN, {"technique": 1, "thickness_update": False}),
+    ("Technique 1, Guccione (anisotropic)", GUCCIONE, {"technique": 1}),
+    ("Technique 2", None, {"technique": 2}),
+    ("Technique 3", None, {"technique": 3}),
+]
+
+
+def scordelis_lo(divisions: int, material: dict | None = None, section: dict | None = None) -> Simulation:
+    """The Scordelis-Lo roof (decks/verification/test05_scordelis_lo_6x6.toml) on
+    ``divisions`` x ``divisions`` elements, with another material or section keys."""
+    data = tomllib.loads((DECKS / "verification" / "test05_scordelis_lo_6x6.toml").read_text())
+    data["mesh"]["divisions"] = {"around": divisions, "along": divisions}
+    data["reference"] = []
+    if material is not None:
+        data["material"] = material
+    data["section"] = data["section"] | (section or {})
+    deck = deck_from_data(data)
+    return Simulation(build_model(deck, build_mesh(deck)))
+
+
+def path_speeds(divisions: int = 16, steps: int = 100, threads: tuple[int, ...] | None = None) -> list[dict]:
+    """Microseconds per element per step of the full time step (forces, update) for each
+    constitutive path of :data:`PATHS` on the Scordelis-Lo roof, on each number of
+    ``threads`` (default: one, and every core numba may use), each from rest at the
+    critical step over 1.25. GFLOP/s where the operation count is known (the small-strain
+    path, :func:`flops_per_element`)."""
+    threads = threads or tuple(sorted({1, numba.config.NUMBA_NUM_THREADS}))
+    rows = []
+    for label, material, section in PATHS:
+        for count in threads:
+            numba.set_num_threads(count)
+            sim = scordelis_lo(divisions, material, section)
+            us = _us_per_element_step(sim, steps, 1.25)
+            row = {"path": label, "threads": count, "elements": sim.model.n_elements, "steps": steps,
+                   "us_per_element_step": us}
+            if not section and material is None:
+                flops = flops_per_element(len(sim.model.rule.tz))
+                row |= {"flops_per_element_step": flops, "gflops": flops / (us * 1e3)}
+            rows.append(row)
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    return rows
 
 
 def _us_per_element_step(sim: Simulation, steps: int, safety_factor: float) -> float:
@@ -65,35 +113,23 @@ def _us_per_element_step(sim: Simulation, steps: int, safety_factor: float) -> f
     return 1e6 * (time.perf_counter() - start) / (taken * sim.model.n_elements)
 
 
-#: Constitutive paths compared by :func:`technique_costs`: (label, material, section keys).
-LINEAR = {"model": "linear_elastic", "E": 1.0e5, "nu": 0.3, "density": 1050.0}
-MOONEY_RIVLIN = {"model": "mooney_rivlin", "C1": 20.0e3, "C2": 5.0e3, "density": 1050.0}
-PATHS = [
-    ("small strain (linear elastic)", LINEAR, {}),
-    ("Technique 1, St. Venant-Kirchhoff", LINEAR, {"technique": 1}),
-    ("Technique 1, Mooney-Rivlin", MOONEY_RIVLIN, {"technique": 1}),
-    ("Technique 1, Mooney-Rivlin, no thickness update", MOONEY_RIVLIN, {"technique": 1, "thickness_update": False}),
-    ("Technique 1, Guccione (anisotropic)", None, {"technique": 1}),
-    ("Technique 2", LINEAR, {"technique": 2}),
-    ("Technique 3", LINEAR, {"technique": 3}),
-]
+#: A matrix product on one thread in a fresh process: the rate this core reaches on
+#: dense fp64 arithmetic, against which the kernel's GFLOP/s is read.
+DGEMM = """
+import time, numpy as np
+n = 1024
+a, b = np.random.default_rng(0).standard_normal((2, n, n))
+best = min((lambda t0: (a @ b, time.perf_counter() - t0)[1])(time.perf_counter()) for _ in range(5))
+print(2 * n**3 / best / 1e9)
+"""
 
 
-def technique_costs(steps: int = 300) -> list[dict]:
-    """Microseconds per element per step of the full time step for each constitutive path
-    of :data:`PATHS` on the Test 9 tube (decks/verification/test09_aorta_slow_M2.toml,
-    19 elements, Guccione where the material is None), from the same state and step."""
-    base = tomllib.loads((DECKS / "verification" / "test09_aorta_slow_M2.toml").read_text())
-    rows = []
-    for label, material, section in PATHS:
-        data = dict(base, reference=[])
-        data["section"] = {k: v for k, v in base["section"].items() if k != "technique"} | section
-        if material is not None:
-            data["material"] = material
-        deck = deck_from_data(data)
-        sim = Simulation(build_model(deck, build_mesh(deck)))
-        rows.append({"path": label, "us_per_element_step": _us_per_element_step(sim, steps, 2.0)})
-    return rows
+def dgemm_gflops() -> float:
+    """GFLOP/s of numpy's matrix product (BLAS dgemm, 1024 x 1024) on one thread."""
+    one = {name: "1" for name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    done = subprocess.run([sys.executable, "-c", DGEMM], capture_output=True, text=True, check=True,
+                          env=os.environ | one)
+    return float(done.stdout)
 
 
 def plate_ladder(divisions=(2, 4, 8)) -> list[dict]:
@@ -102,14 +138,14 @@ def plate_ladder(divisions=(2, 4, 8)) -> list[dict]:
     rows = []
     for n in divisions:
         deck = parse_deck(text.replace("length = 2, width = 2", f"length = {n}, width = {n}"))
-        mesh = build_mesh(deck)
-        run = integrate(prepare(deck, mesh, build_model(deck, mesh)))
+        run = integrate(built_run(deck, DECKS / "bench"))
         times = np.asarray(run.times)
         results = {r.measure: check(r, times, np.asarray(run.history[r.probe])) for r in deck.reference}
         rows.append({
-            "mesh": f"{n}x{n}", "elements": mesh.n_elements, "steps": run.sim.state.steps,
+            "mesh": f"{n}x{n}", "elements": run.mesh.n_elements, "steps": run.sim.state.steps,
             "wall_time_s": run.wall_time, "peak_error_percent": results["min"]["error_percent"],
             "peak_time_error_percent": results["first_peak_time"]["error_percent"],
-            "us_per_element_step": 1e6 * run.wall_time / (run.sim.state.steps * mesh.n_elements),
+            "us_per_element_step": 1e6 * run.wall_time / (run.sim.state.steps * run.mesh.n_elements),
+            "startup_s": run.startup,
         })
     return rows

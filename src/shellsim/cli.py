@@ -315,36 +315,52 @@ def report(
 def bench(
     out_dir: Annotated[Path | None, typer.Option("--out", help="Also write bench.json here.")] = None,
 ) -> None:
-    """Measure speed: microseconds per element per step and GFLOP/s of the element kernel
-    (Scordelis-Lo 16 x 16), the cost of each constitutive path, and the bench plate's
-    error and wall time per mesh."""
-    from .bench import kernel_speed, plate_ladder, technique_costs
+    """Measure speed: microseconds per element per step of each constitutive path on the
+    Scordelis-Lo roof (16 x 16) on one thread and on every core, GFLOP/s against a
+    one-thread matrix product, and the bench plate's error and wall time per mesh."""
+    from .bench import dgemm_gflops, path_speeds, plate_ladder
 
-    kernel = kernel_speed()
-    out.print(f"kernel (Scordelis-Lo, {kernel['elements']} elements, {kernel['steps']} steps): "
-              f"{kernel['us_per_element_step']:.2f} us per element-step, "
-              f"{kernel['flops_per_element_step']:,} flop per element-step, {kernel['gflops']:.2f} GFLOP/s")
-    costs = technique_costs()
-    small = costs[0]["us_per_element_step"]
-    paths = Table(title="constitutive paths (Test 9 tube, 19 elements)", title_justify="left")
-    for column in ("path", "us/element-step", "against small strain"):
-        paths.add_column(column)
-    for row in costs:
-        paths.add_row(row["path"], f"{row['us_per_element_step']:.2f}", f"{row['us_per_element_step'] / small:.2f} x")
-    out.print(paths)
+    rows = path_speeds()
+    dgemm = dgemm_gflops()
+    out.print(_paths_table(rows))
+    for row in rows:
+        if "gflops" in row:
+            out.print(f"{row['path']}, {row['threads']} thread(s): {row['flops_per_element_step']:,} flop per "
+                      f"element-step, {row['gflops']:.2f} GFLOP/s = {100 * row['gflops'] / (dgemm * row['threads']):.1f}% "
+                      f"of a one-thread matrix product's {dgemm:.1f} GFLOP/s per thread")
     ladder = plate_ladder()
     table = Table(title="bench plate (decks/bench/plate_step.toml): first peak", title_justify="left")
-    for column in ("mesh", "elements", "steps", "wall time [s]", "us/element-step", "peak error", "peak time error"):
+    for column in ("mesh", "elements", "steps", "start-up: mesh + model + kernels + first dt [s]", "wall time [s]",
+                   "us/element-step", "peak error", "peak time error"):
         table.add_column(column)
     for row in ladder:
-        table.add_row(row["mesh"], str(row["elements"]), str(row["steps"]), f"{row['wall_time_s']:.2f}",
+        startup = " + ".join(f"{row['startup_s'][k]:.2f}" for k in ("mesh_s", "model_s", "kernels_s", "first_dt_s"))
+        table.add_row(row["mesh"], str(row["elements"]), str(row["steps"]), startup, f"{row['wall_time_s']:.2f}",
                       f"{row['us_per_element_step']:.2f}", f"{row['peak_error_percent']:+.3f}%",
                       f"{row['peak_time_error_percent']:+.3f}%")
     out.print(table)
     if out_dir is not None:
         from .output.summary import write_json
 
-        write_json({"kernel": kernel, "paths": costs, "plate": ladder}, output_folder(out_dir) / "bench.json")
+        write_json({"paths": rows, "dgemm_gflops_one_thread": dgemm, "plate": ladder}, output_folder(out_dir) / "bench.json")
+
+
+def _paths_table(rows: list[dict]) -> Table:
+    """Microseconds per element-step of each constitutive path (rows of
+    :func:`shellsim.bench.path_speeds`), one column per thread count."""
+    elements = rows[0]["elements"]
+    threads = sorted({r["threads"] for r in rows})
+    paths = Table(title=f"constitutive paths (Scordelis-Lo, {elements} elements, {rows[0]['steps']} steps): "
+                        "us per element-step", title_justify="left")
+    for column in ("path", *(f"{t} thread{'s' * (t > 1)}" for t in threads), "speed-up"):
+        paths.add_column(column)
+    by_path: dict[str, dict[int, dict]] = {}
+    for row in rows:
+        by_path.setdefault(row["path"], {})[row["threads"]] = row
+    for path, runs in by_path.items():
+        first, last = runs[threads[0]]["us_per_element_step"], runs[threads[-1]]["us_per_element_step"]
+        paths.add_row(path, *(f"{runs[t]['us_per_element_step']:.2f}" for t in threads), f"{first / last:.2f} x")
+    return paths
 
 
 #: ``check`` suggests M1 to an M2 scene when M1's critical step is this many times larger.

@@ -9,7 +9,26 @@ from pathlib import Path
 from . import __version__
 from .deck import Deck
 from .errors import NumericalError, OutputError
-from .solver.run import Listener, Listeners, Run, Timed
+from .solver.run import Listener, Listeners, Run, Stopwatch, Timed
+
+
+def built_run(scene: Deck, deck_folder: Path) -> Run:
+    """A run of ``scene`` ready to start (mesh, model, simulation; files named in the deck
+    are read relative to ``deck_folder``), with the seconds each took in ``run.startup``:
+    mesh_s, model_s, and kernels_s, the first masses and forces (the kernels compiled, or
+    loaded from numba's cache). :func:`shellsim.solver.run.integrate` adds first_dt_s."""
+    from .geometry import build_mesh
+    from .model import build_model
+    from .solver.run import prepare
+
+    clock = Stopwatch()
+    mesh = build_mesh(scene, deck_folder)
+    mesh_s = clock.lap()
+    model = build_model(scene, mesh)
+    model_s = clock.lap()
+    run = prepare(scene, mesh, model)
+    run.startup |= {"mesh_s": mesh_s, "model_s": model_s, "kernels_s": clock.lap()}
+    return run
 
 
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None) -> tuple[Run, dict]:
@@ -19,17 +38,14 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     ended ('completed', 'unstable', 'interrupted', 'output failed') and the summary's
     ``message`` why. Renders are left to the caller."""
     from .deck.resolved import RESOLVED_NAME, resolved_text
-    from .geometry import build_mesh
-    from .model import build_model
     from .output.folder import write_atomically
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
     from .output.summary import summary, write_json
     from .plan import plan
-    from .solver.run import integrate, output_times, prepare
+    from .solver.run import integrate, output_times
 
-    mesh = build_mesh(scene, deck_path.parent)
-    current = prepare(scene, mesh, build_model(scene, mesh))
+    current = built_run(scene, deck_path.parent)
     write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
     message = None
     with ExitStack() as files:

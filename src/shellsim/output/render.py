@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -177,7 +177,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     for index, (point_data, _), (values, on_cells, _) in zip(indices, frames, picked):
         path = out_dir / f"{stem}_{index:04d}.png"
         deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
-        _render_frame(deformed, series, values, on_cells, bar, (low, high), view, size,
+        _render_frame(deformed, series, Colouring(values, on_cells, bar, (low, high)), view, size,
                       f"{title}\nt = {series.times[index]:.6g}", path)
         written.append(path)
     if frame == "all":
@@ -189,9 +189,20 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     return written
 
 
-def _render_frame(points: np.ndarray, series, values: np.ndarray, on_cells: bool, bar: str,
-                  limits: tuple[float, float], view: str, size: tuple[int, int], caption: str, path: Path) -> None:
-    """One PNG: the sub-cells at ``points`` coloured by ``values``, element outlines on top."""
+class Colouring(NamedTuple):
+    """A field's values on the sub-cells (``on_cells``) or their corners, the scalar bar's
+    title and its (low, high) limits."""
+
+    values: np.ndarray
+    on_cells: bool
+    bar: str
+    limits: tuple[float, float]
+
+
+def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, size: tuple[int, int], caption: str,
+                  path: Path) -> None:
+    """One PNG: the sub-cells at ``points`` coloured by ``colouring``, element outlines on top."""
+    values, on_cells, bar, limits = colouring
     pv = _pyvista()
     cell_type = pv.CellType.HEXAHEDRON if series.cell_type == "hexahedron" else pv.CellType.QUAD
     grid = pv.UnstructuredGrid({cell_type: series.cells}, points)

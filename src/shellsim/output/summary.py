@@ -48,6 +48,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "frames": len(run.frame_times),
         "units": run.deck.meta.units,
         "us_per_element_step": 1e6 * (run.wall_time - output_seconds) / (steps * model.n_elements),
+        "startup_s": run.startup,
         "dt": dt_statistics(run),
         "energy": {
             "internal": float(e[INTERNAL]), "kinetic": float(e[KINETIC]),

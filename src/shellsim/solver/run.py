@@ -8,7 +8,6 @@ history time, ``listener.on_frame(run)`` at t = 0 and at every output time, and
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -69,6 +68,7 @@ class Run:
     frame_times: list[float] = field(default_factory=list)
     wall_time: float = 0.0
     status: str = "running"
+    startup: dict[str, float] = field(default_factory=dict)  # fixed costs before stepping [s]
 
     @property
     def balance_error(self) -> float:
@@ -107,6 +107,18 @@ class Listeners(Listener):
     def on_frame(self, run: Run) -> None:
         for listener in self.listeners:
             listener.on_frame(run)
+
+
+class Stopwatch:
+    """Seconds between successive :meth:`lap` calls (the first from its creation)."""
+
+    def __init__(self):
+        self._last = time.perf_counter()
+
+    def lap(self) -> float:
+        now = time.perf_counter()
+        elapsed, self._last = now - self._last, now
+        return elapsed
 
 
 class Timed(Listener):
@@ -249,6 +261,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     start = time.perf_counter()
     try:
         _update_time_step(run, listener)
+        run.startup["first_dt_s"] = time.perf_counter() - start
         _record(run, listener)
         _frame(run, listener)
         since_update = 0
@@ -291,7 +304,7 @@ def step_outlook(deck: Deck, model: Model) -> dict:
     [time] with each lumping, ``{"M1": .., "M2": ..}``, and ``steps``, the number of steps
     to the end time with the deck's lumping and safety factor at that step (a stiffening
     scene takes more)."""
-    critical = {mass: Simulation(dataclasses.replace(model, mass=mass)).critical_time_step() for mass in ("M1", "M2")}
+    critical = {mass: Simulation(model._replace(mass=mass)).critical_time_step() for mass in ("M1", "M2")}
     dt = critical[deck.solver.mass] / deck.solver.dt_safety_factor
     if deck.solver.dt_max is not None:
         dt = min(dt, deck.solver.dt_max)

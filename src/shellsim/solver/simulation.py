@@ -4,12 +4,14 @@ in time. Holds arrays only; the time loop itself is compiled (:mod:`.explicit`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ..bundles import Fields, Shape
 from ..element import kernels
 from ..element.sampling import point_tensors
+from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..model import Model
 from . import explicit
@@ -34,6 +36,14 @@ class State:
         return getattr(fields.shape if name in Shape._fields else fields, name)
 
 
+class Compiled(NamedTuple):
+    """The compiled functions a simulation calls often, each bound to its argument types."""
+
+    advance: TypedCall
+    masses: TypedCall
+    stiffness: TypedCall
+
+
 class Simulation:
     """A model and its state, advanced by central differences."""
 
@@ -48,6 +58,8 @@ class Simulation:
             prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(4),
             energy=np.zeros(4)))
         self.workspace = explicit.workspace(model)
+        self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(kernels.lumped_masses),
+                                 stiffness=TypedCall(kernels.stiffness_product))
         self._eigenvector: np.ndarray | None = None
         self.update_masses()
         self.evaluate_forces()
@@ -55,7 +67,7 @@ class Simulation:
     def update_masses(self) -> None:
         """Lumped masses on the current configuration (M1 or M2, thesis 3.14)."""
         m, s = self.model, self.state
-        kernels.lumped_masses(m.rule, m.body, s.fields.shape, m.density, m.mass == "M1", s.mt, s.mr)
+        self.compiled.masses(m.rule, m.body, s.fields.shape, float(m.density), m.mass == "M1", s.mt, s.mr)
 
     def volume(self, initial: bool = False) -> float:
         """Volume of the shell body now (or at the start) [length^3]: int dv over every
@@ -63,7 +75,7 @@ class Simulation:
         m, s = self.model, self.state
         shape = Shape(x=m.x0, d=m.d0, e1=m.e1f0, h=m.h0) if initial else s.fields.shape
         mt, mr = np.empty(m.n_nodes), np.empty(m.n_nodes)
-        kernels.lumped_masses(m.rule, m.body, shape, 1.0, False, mt, mr)
+        self.compiled.masses(m.rule, m.body, shape, 1.0, False, mt, mr)
         return float(mt.sum())
 
     def point_tensors(self, elements=slice(None), points=slice(None)) -> tuple[np.ndarray, ...]:
@@ -106,4 +118,5 @@ class Simulation:
 
     def _advance(self, t_stop: float, dt: float, max_steps: int) -> tuple[float, float, int]:
         s = self.state
-        return explicit.advance(s.t, t_stop, max_steps, dt, s.dt_prev, self.model, s.fields, self.workspace)
+        return self.compiled.advance(float(s.t), float(t_stop), int(max_steps), float(dt), float(s.dt_prev), self.model,
+                                     s.fields, self.workspace)

@@ -35,7 +35,7 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
         z = np.asarray(z).ravel()
         vu = np.einsum("nij,nj->ni", projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
         vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * rot_free
-        kernels.stiffness_product(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, chunks)
+        sim.compiled.stiffness(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, chunks)
         out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])

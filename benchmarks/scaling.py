@@ -30,7 +30,6 @@ scene, divisions, steps = sys.argv[1], json.loads(sys.argv[2]), int(sys.argv[3])
 path = {"plate": "decks/bench/plate_step.toml", "tube": "decks/artery_inflation.toml"}[scene]
 data = tomllib.loads(open(path).read())
 data["mesh"]["divisions"] = divisions
-data["output"] = {"interval": data["solver"]["end_time"]}
 run = built_run(deck_from_data(data), ROOT)
 sim = run.sim
 start = time.perf_counter()
@@ -66,6 +65,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[100, 1000, 10000, 100000])
     parser.add_argument("--threads", type=int, default=None, help="kernel threads (default: numba's, every core)")
+    parser.add_argument("--scenes", nargs="+", default=["plate", "tube"], choices=["plate", "tube"])
     args = parser.parse_args()
     env = dict(os.environ)
     if args.threads:
@@ -73,7 +73,7 @@ def main() -> None:
     print("| scene | elements | steps | us/element-step | peak memory/element [kB] | mesh [s] | model [s] "
           "| kernels [s] | first dt [s] |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for scene in ("plate", "tube"):
+    for scene in args.scenes:
         for size in args.sizes:
             split = divisions(scene, size)
             done = subprocess.run([sys.executable, "-c", f"ROOT = {str(ROOT)!r}\n" + CHILD, scene, json.dumps(split),

@@ -89,7 +89,7 @@ def stiffness(model, vu, vr, x=None, stress=None):
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
     kernels.stiffness_product(model.rule, model.body, model.material, shape, stress, vu, vr, f, fr,
-                              kernels.element_chunks(model.n_elements))
+                              kernels.assembly(n, model.n_elements), kernels.element_chunks(model.n_elements))
     return f, fr
 
 

@@ -88,7 +88,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     curve_names = list(deck.curves)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
     return Model(
-        rule=rule, body=body, material=_material(deck, mesh, rule), loads=_loads(deck, mesh, curve_names, rule, initial),
+        rule=rule, body=body, material=_material(deck, mesh, rule), loads=_loads(deck, mesh, curve_names, rule, body, initial),
         curves=_curve_tables(deck, curve_names), constraints=constraints,
         x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0, density=deck.material.density, mass=deck.solver.mass,
         damping=deck.solver.damping,
@@ -286,7 +286,7 @@ def _edge_integral(x0: np.ndarray, edges: np.ndarray) -> np.ndarray:
     return np.einsum("pk,mp,p->mk", EDGE_N, np.linalg.norm(tangent, axis=-1), EDGE_W)
 
 
-def _loads(deck: Deck, mesh: Mesh, curve_names, rule: Rule, initial: Shape) -> Loads:
+def _loads(deck: Deck, mesh: Mesh, curve_names, rule: Rule, body: Body, initial: Shape) -> Loads:
     """Every load of ``deck`` as tables (:class:`~shellsim.bundles.Loads`): dead nodal
     vectors (edge, point, body, dead pressure, taken on the ``initial`` shape) and
     follower pressures evaluated every step, each with its curve's index."""
@@ -315,7 +315,7 @@ def _loads(deck: Deck, mesh: Mesh, curve_names, rule: Rule, initial: Shape) -> L
             faces = PressureLoads(elements=named.elements.astype(np.int64),
                                   face=np.full(len(named.elements), FACES[load.face]),
                                   value=np.full(len(named.elements), load.value), curve=np.full(len(named.elements), -1))
-            pressure_forces(rule, mesh.conn.astype(np.int64), initial, faces, faces.value, force, g)
+            pressure_forces(rule, body.conn, initial, faces, faces.value, force, g)
         elif load.type in ("edge_force", "edge_moment"):
             target = force if load.type == "edge_force" else moment
             np.add.at(target, named.edges, _edge_integral(mesh.x, named.edges)[:, :, None] * np.asarray(load.value))

@@ -632,8 +632,7 @@ class ElementScratch(NamedTuple):
     per in-plane point (npts, 3) cbar, Bab, T; at the Gauss points (nq, nt, ...) FP and
     LP (3, 3) deformation and field gradients, EPS0 (5) strains before the tying;
     coef, rhs (nb,), Mb (nb, nb) of the volumetric projection. Then one element's
-    gathered xe, de, ue, ve (9, 3), he (9,), its forces fe, ge (9, 3) and normal
-    stretches stretch (nq,)."""
+    gathered xe, de, ue, ve (9, 3), he (9,) and its normal stretches stretch (nq,)."""
 
     jac: np.ndarray
     jinv: np.ndarray
@@ -678,8 +677,6 @@ class ElementScratch(NamedTuple):
     ue: np.ndarray
     ve: np.ndarray
     he: np.ndarray
-    fe: np.ndarray
-    ge: np.ndarray
     stretch: np.ndarray
 
 
@@ -699,23 +696,21 @@ def _scratch(npts, nt, nb, nq):
         T=np.empty((npts, 3)), FP=np.empty((nq, nt, 3, 3)), LP=np.empty((nq, nt, 3, 3)), EPS0=np.empty((nq, nt, 5)),
         coef=np.empty(nb), rhs=np.empty(nb), Mb=np.empty((nb, nb)),
         xe=np.empty((9, 3)), de=np.empty((9, 3)), ue=np.empty((9, 3)), ve=np.empty((9, 3)), he=np.empty(9),
-        fe=np.empty((9, 3)), ge=np.empty((9, 3)), stretch=np.ones(nq))
+        stretch=np.ones(nq))
 
 
 class Assembly(NamedTuple):
     """Per-element results before they are summed at the nodes (ne elements, n nodes):
     fe, ge (ne, 9, 3) translational and director-conjugate forces; volume, stretch (ne,)
     the element's volume and volume-weighted normal stretch (fibre-length update);
-    g (n, 3) the summed director-conjugate forces; weighted, weights (n,) the nodal
-    sums of stretch and volume. Allocated once per model (:func:`assembly`)."""
+    g (n, 3) the summed director-conjugate forces. Allocated once per model
+    (:func:`assembly`)."""
 
     fe: np.ndarray
     ge: np.ndarray
     volume: np.ndarray
     stretch: np.ndarray
     g: np.ndarray
-    weighted: np.ndarray
-    weights: np.ndarray
 
 
 def element_chunks(n_elements: int) -> int:
@@ -727,8 +722,7 @@ def element_chunks(n_elements: int) -> int:
 def assembly(n_nodes: int, n_elements: int) -> Assembly:
     """An :class:`Assembly` for a mesh of that size."""
     return Assembly(fe=np.zeros((n_elements, 9, 3)), ge=np.zeros((n_elements, 9, 3)), volume=np.zeros(n_elements),
-                    stretch=np.zeros(n_elements), g=np.zeros((n_nodes, 3)), weighted=np.zeros(n_nodes),
-                    weights=np.zeros(n_nodes))
+                    stretch=np.zeros(n_elements), g=np.zeros((n_nodes, 3)))
 
 
 @njit(cache=True, error_model="numpy")
@@ -765,7 +759,6 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
     them and feeds back into lambda_3 (a loop no energy stands behind, which broke Test 10
     down). The updated h moves the faces (pressure, probes), masses and volume.
     """
-    h0, h = body.h0, shape.h
     hyper = material.law != hyperelastic.LINEAR
     ne = body.conn.shape[0]
     # Technique 1 sets h = h0 lambda_3 (total), Techniques 2 and 3 scale h by each step's
@@ -775,12 +768,10 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
     for c in prange(chunks):
         _element_chunk(c * ne // chunks, (c + 1) * ne // chunks, mode, rule, body, material, shape, ux, ud, stress,
                        state_stress, parts, update)
-    _gather_at_nodes(body, parts, update, f)
+    _gather_at_nodes(body, parts, f)
     to_rotational(parts.g, shape.d, shape.e1, fr)
     if update:
-        for node in range(h.shape[0]):
-            if parts.weights[node] > 0.0:
-                h[node] = (h[node] if incremental_update else h0[node]) * parts.weighted[node] / parts.weights[node]
+        _update_fibre_lengths(body, parts, shape.h, incremental_update)
 
 
 @njit(cache=True, error_model="numpy")
@@ -816,26 +807,33 @@ def _element_chunk(start, stop, mode, rule, body, material, shape, ux, ud, stres
 
 
 @njit(cache=True, error_model="numpy")
-def _gather_at_nodes(body, parts, update, f):
-    """The nodal sums of ``parts`` (:class:`Assembly`), each node's slots in ascending
-    order: f (n, 3) from fe, parts.g from ge, and (``update``) parts.weighted and
-    parts.weights from the elements' stretch and volume."""
+def _gather_at_nodes(body, parts, f):
+    """The nodal sums of the element forces in ``parts`` (:class:`Assembly`), each node's
+    slots in ascending order: f (n, 3) from fe, parts.g from ge."""
     g = parts.g
     for node in range(g.shape[0]):
         f[node, :] = 0.0
         g[node, :] = 0.0
-        weighted = 0.0
-        weights = 0.0
         for slot in range(body.node_slots[node], body.node_slots[node + 1]):
             e, a = divmod(body.slots[slot], 9)
             for i in range(3):
                 f[node, i] += parts.fe[e, a, i]
                 g[node, i] += parts.ge[e, a, i]
-            if update:
-                weighted += parts.stretch[e]
-                weights += parts.volume[e]
-        parts.weighted[node] = weighted
-        parts.weights[node] = weights
+
+
+@njit(cache=True, error_model="numpy")
+def _update_fibre_lengths(body, parts, h, incremental):
+    """h (n,) = (h, incremental; else h0) x the volume-weighted mean of the normal
+    stretches of the node's elements (``parts``), summed in ascending element order."""
+    for node in range(h.shape[0]):
+        weighted = 0.0
+        weights = 0.0
+        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
+            e = body.slots[slot] // 9
+            weighted += parts.stretch[e]
+            weights += parts.volume[e]
+        if weights > 0.0:
+            h[node] = (h[node] if incremental else body.h0[node]) * weighted / weights
 
 
 @njit(cache=True, error_model="numpy")
@@ -863,7 +861,7 @@ def internal_forces(rule, body, material, shape, dx, dd, stress, f, fr, parts, c
 
 
 @njit(cache=True, error_model="numpy")
-def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, chunks):
+def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts, chunks):
     """Tangent stiffness times a DOF vector, K v, without forming K: the material part
     K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
     Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
@@ -871,15 +869,12 @@ def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, chunks
     from K_L alone was too long on refined meshes).
 
     vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
-    fr (n, 2). Other arguments as :func:`internal_forces`.
+    fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
+    loop's: it is scratch between steps).
     """
-    x = shape.x
-    vd = np.empty((x.shape[0], 3))
+    vd = np.empty((shape.x.shape[0], 3))
     director_increments(vr, shape.d, shape.e1, vd)
-    ne = body.conn.shape[0]
-    field_stress = np.empty((ne, rule.wq.shape[0], rule.tz.shape[0], 5))
-    parts = Assembly(fe=np.empty((ne, 9, 3)), ge=np.empty((ne, 9, 3)), volume=np.empty(ne), stretch=np.empty(ne),
-                     g=np.empty((x.shape[0], 3)), weighted=np.empty(x.shape[0]), weights=np.empty(x.shape[0]))
+    field_stress = np.empty((body.conn.shape[0], rule.wq.shape[0], rule.tz.shape[0], 5))
     _all_elements(LINEAR, rule, body, material, shape, vu, vd, field_stress, stress, f, fr, parts, chunks)
 
 

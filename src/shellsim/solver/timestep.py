@@ -12,7 +12,6 @@ from __future__ import annotations
 import numpy as np
 from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
-from ..element import kernels
 
 #: Lanczos basis size. Warm-started from the last estimate's eigenvector, the estimate
 #: converges within its first basis, so ARPACK's default of 20 vectors spends three times
@@ -29,13 +28,14 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
     inv_sqrt_r = 1.0 / np.sqrt(s.mr)
     fu, fr = np.empty((n, 3)), np.empty((n, 2))
     projector, rot_free = m.constraints.projector, m.constraints.rot_free
-    chunks = kernels.element_chunks(m.n_elements)
+    space = sim.workspace
 
     def apply(z: np.ndarray) -> np.ndarray:
         z = np.asarray(z).ravel()
         vu = np.einsum("nij,nj->ni", projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
         vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * rot_free
-        sim.compiled.stiffness(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, chunks)
+        sim.compiled.stiffness(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts,
+                               space.chunks)
         out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])

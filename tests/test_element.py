@@ -9,7 +9,8 @@ import pytest
 
 from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
-from shellsim.element import kernels
+from shellsim.element.assembly import assembly, internal_forces, stiffness_product
+from shellsim.element.masses import lumped_masses
 from shellsim.element.frames import rotate_director
 from shellsim.element.sampling import point_tensors
 from shellsim.geometry import build_mesh
@@ -75,8 +76,8 @@ def internal(model, x, d, e1, h=None, step=None, stress=None):
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=x, d=d, e1=e1, h=model.h0.copy() if h is None else h)
     material = model.material._replace(incremental=step is not None)
-    kernels.internal_forces(model.rule, model.body, material, shape, x * 0 if step is None else step, x * 0, stress, f, fr,
-                            kernels.assembly(n, model.n_elements), kernels.element_chunks(model.n_elements))
+    internal_forces(model.rule, model.body, material, shape, x * 0 if step is None else step, x * 0, stress, f, fr,
+                    assembly(n, model.n_elements))
     return f, fr, stress
 
 
@@ -88,8 +89,7 @@ def stiffness(model, vu, vr, x=None, stress=None):
     if stress is None:
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
-    kernels.stiffness_product(model.rule, model.body, model.material, shape, stress, vu, vr, f, fr,
-                              kernels.assembly(n, model.n_elements), kernels.element_chunks(model.n_elements))
+    stiffness_product(model.rule, model.body, model.material, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
     return f, fr
 
 
@@ -277,7 +277,7 @@ def test_lumped_masses_add_up_and_are_positive(curved, mass):
     model = curved
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    kernels.lumped_masses(model.rule, model.body, initial_shape(model), 7.0, mass == "M1", mt, mr)
+    lumped_masses(model.rule, model.body, initial_shape(model), 7.0, mass == "M1", mt, mr)
     volume = np.sum(1.0 / np.abs(np.linalg.det(model.body.jac0_inv[:, :9])) * model.rule.wq[None, :, None] * model.rule.wt[None, None, :])
     assert mt.sum() == pytest.approx(7.0 * volume, rel=1e-12)
     assert np.all(mt > 0) and np.all(mr > 0)
@@ -287,7 +287,7 @@ def test_m2_masses_of_a_rectangle_are_the_tensor_product_of_simpson_weights():
     _, model = make_model('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "divisions = { length = 1, width = 1 }")
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    kernels.lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
+    lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
     total = 2.0 * 1.0 * T
     np.testing.assert_allclose(mt[model.conn[0]], total * np.array([1, 1, 1, 1, 4, 4, 4, 4, 16]) / 36, rtol=1e-12)
     np.testing.assert_allclose(mr / mt, T**2 / 12, rtol=1e-12)  # director inertia of the fibre
@@ -429,7 +429,7 @@ def test_m2_rotary_inertia_does_not_depend_on_the_thickness_rule():
                               material=('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
                                         f"points_through_thickness = {points}"))
         mt, mr = np.empty(model.n_nodes), np.empty(model.n_nodes)
-        kernels.lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
+        lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
         masses.append(mr)
     assert masses[1].min() > 0.0
     np.testing.assert_allclose(masses[0], masses[1], rtol=1e-12)

@@ -16,8 +16,8 @@ def _numba_cache_dir() -> str:
     """A compiled-code cache folder keyed by the package's source.
 
     numba checks a cached function against its own file only, so after a change to
-    element/kernels.py the time loop in solver/explicit.py would keep running the old
-    kernels compiled into it. One folder per version of the whole source avoids that.
+    element/response.py the time loop in solver/explicit.py would keep running the old
+    element code compiled into it. One folder per version of the whole source avoids that.
     """
     digest = hashlib.sha1()
     for path in sorted(Path(__file__).parent.rglob("*.py")):

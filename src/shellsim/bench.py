@@ -30,7 +30,7 @@ DECKS = Path(__file__).resolve().parents[2] / "decks"
 def flops_per_element(n_thick: int = 2) -> int:
     """Floating-point operations (additions, multiplications, divisions, square roots; a
     fused multiply-add counts 2) of one element's internal force in the total formulation,
-    counted from :func:`shellsim.element.kernels._element_response`.
+    counted from :func:`shellsim.element.response.group_response`.
 
     Per point (25 in-plane points: 9 integration + 16 membrane tying points, times n_thick):
       geometry: Jacobian 252, determinant 14, inverse 36, lamina frame 60, gradient

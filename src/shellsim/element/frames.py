@@ -1,7 +1,7 @@
 """Lamina and fibre coordinate systems and the director update (thesis 2.5.1.2, 3.2, 3.3).
 
-All functions are compiled with numba and work on one point or one node, so the element
-kernels can call them in their loops.
+All functions are compiled with numba and work on one node (the lamina frame of the
+integration points is :func:`shellsim.element.kinematics.lamina_frame`).
 """
 
 from __future__ import annotations
@@ -25,34 +25,6 @@ def normalize(a: np.ndarray) -> None:
     a[0] /= n
     a[1] /= n
     a[2] /= n
-
-
-@njit(cache=True, error_model="numpy")
-def lamina_frame(jac: np.ndarray, q: np.ndarray) -> None:
-    """Hughes' lamina basis at a point from the tangents g_r = jac[:, 0], g_s = jac[:, 1].
-
-    e3 is the lamina normal; e1, e2 lie in the lamina, symmetric about the bisector of
-    e_r and e_s (thesis Eq 2.57 and Figure 2.11). Writes q (3, 3) with rows e1, e2, e3
-    (the global -> lamina rotation [q]). Scalar arithmetic only: it runs at every
-    integration point of every step.
-    """
-    nr = np.sqrt(jac[0, 0] ** 2 + jac[1, 0] ** 2 + jac[2, 0] ** 2)
-    ns = np.sqrt(jac[0, 1] ** 2 + jac[1, 1] ** 2 + jac[2, 1] ** 2)
-    rx, ry, rz = jac[0, 0] / nr, jac[1, 0] / nr, jac[2, 0] / nr
-    sx, sy, sz = jac[0, 1] / ns, jac[1, 1] / ns, jac[2, 1] / ns
-    nx, ny, nz = ry * sz - rz * sy, rz * sx - rx * sz, rx * sy - ry * sx
-    n = np.sqrt(nx * nx + ny * ny + nz * nz)
-    nx, ny, nz = nx / n, ny / n, nz / n
-    ax, ay, az = rx + sx, ry + sy, rz + sz
-    a = np.sqrt(ax * ax + ay * ay + az * az)
-    ax, ay, az = ax / a, ay / a, az / a
-    bx, by, bz = ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
-    b = np.sqrt(bx * bx + by * by + bz * bz)
-    bx, by, bz = bx / b, by / b, bz / b
-    c = np.sqrt(0.5)
-    q[0, 0], q[0, 1], q[0, 2] = c * (ax - bx), c * (ay - by), c * (az - bz)
-    q[1, 0], q[1, 1], q[1, 2] = c * (ax + bx), c * (ay + by), c * (az + bz)
-    q[2, 0], q[2, 1], q[2, 2] = nx, ny, nz
 
 
 @njit(cache=True, error_model="numpy")
@@ -83,22 +55,25 @@ def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
 
     Crossing with the previous step's e1f instead of a fixed global axis keeps the frame's
     sense through any rotation (bending past 90 degrees no longer flips it). e1 (3,) is
-    updated in place.
+    updated in place. Scalars only: it runs at every node of every step.
     """
-    e2 = np.empty(3)
-    cross(d, e1, e2)
-    normalize(e2)
-    cross(e2, d, e1)
+    e2x, e2y, e2z = d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]
+    n = np.sqrt(e2x * e2x + e2y * e2y + e2z * e2z)
+    e2x, e2y, e2z = e2x / n, e2y / n, e2z / n
+    e1[0] = e2y * d[2] - e2z * d[1]
+    e1[1] = e2z * d[0] - e2x * d[2]
+    e1[2] = e2x * d[1] - e2y * d[0]
 
 
 @njit(cache=True, error_model="numpy")
 def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: float) -> None:
     """Director update by trial increment and normalisation (thesis 3.2, Eq 2.62):
-    d <- (d - dtheta1 e1f - dtheta2 e2f) / |...|, then the fibre frame follows. In place."""
-    e2 = np.empty(3)
-    cross(d, e1, e2)
-    for i in range(3):
-        d[i] -= dtheta1 * e1[i] + dtheta2 * e2[i]
+    d <- (d - dtheta1 e1f - dtheta2 e2f) / |...|, e2f = d x e1f, then the fibre frame
+    follows. In place."""
+    e2x, e2y, e2z = d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]
+    d[0] -= dtheta1 * e1[0] + dtheta2 * e2x
+    d[1] -= dtheta1 * e1[1] + dtheta2 * e2y
+    d[2] -= dtheta1 * e1[2] + dtheta2 * e2z
     normalize(d)
     update_fibre_frame(d, e1)
 

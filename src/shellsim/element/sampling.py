@@ -7,7 +7,8 @@ import numpy as np
 from numba import njit
 
 from ..tensor3 import congruence
-from .kernels import _gather, _lamina_to_global, _point_geometry
+from .kinematics import global_stress, point_geometry
+from .lanes import LANES, gather_nodal_scalars, gather_nodal_vectors, group_members, lane_copy
 
 
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,
@@ -30,7 +31,7 @@ def pressure_band(sigma: np.ndarray) -> np.ndarray:
     return -np.trace(sigma, axis1=-2, axis2=-1) / 3.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauchy, green):
     """Tensors at every integration point (element e, in-plane point q, layer k).
 
@@ -44,19 +45,36 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     ``green``, the Green-Lagrange strain (F^T F - I) / 2 in global axes with
     F = dx/d(r, s, t) (dX/d(r, s, t))^-1.
     """
-    xe, de, he = np.empty((9, 3)), np.empty((9, 3)), np.empty(9)
-    jac, jinv, q, F, eye = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.eye(3)
-    gN, gM = np.empty((9, 3)), np.empty((9, 3))
-    for e in range(conn.shape[0]):
-        _gather(conn[e], x, d, h, xe, de, he)
+    ne = conn.shape[0]
+    members = np.empty(LANES, dtype=np.int64)
+    xe, de, he = np.empty((9, 3, LANES)), np.empty((9, 3, LANES)), np.empty((9, LANES))
+    jac, jinv, q, det = np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty(LANES)
+    s5, sg, same = np.empty((5, LANES)), np.empty((3, 3, LANES)), np.zeros((3, 3, LANES))
+    for i in range(3):
+        same[i, i, :] = 1.0  # the lamina frame is its own
+    jac1, F, eye = np.empty((3, 3)), np.empty((3, 3)), np.eye(3)
+    for group in range(-(-ne // LANES)):
+        count = group_members(group, ne, members)
+        gather_nodal_vectors(conn, members, x, xe)
+        gather_nodal_vectors(conn, members, d, de)
+        gather_nodal_scalars(conn, members, h, he)
         for p in range(N.shape[0]):
             for k in range(tz.shape[0]):
-                _point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, gN, gM)
-                _lamina_to_global(stress[e, p, k], eye, lamina[e, p, k])  # the lamina frame is its own
-                _lamina_to_global(stress[e, p, k], q, cauchy[e, p, k])
-                congruence(jac, jac0_inv[e, p, k], eye, F)
-                strain = green[e, p, k]
-                congruence(F.T, eye, F.T, strain)
-                for i in range(3):
-                    for j in range(3):
-                        strain[i, j] = 0.5 * (strain[i, j] - eye[i, j])
+                point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, det)
+                for i in range(5):
+                    for lane in range(LANES):
+                        s5[i, lane] = stress[members[lane], p, k, i]
+                global_stress(s5, same, sg)
+                for lane in range(count):
+                    lane_copy(sg, lane, lamina[members[lane], p, k])
+                global_stress(s5, q, sg)
+                for lane in range(count):
+                    e = members[lane]
+                    lane_copy(sg, lane, cauchy[e, p, k])
+                    lane_copy(jac, lane, jac1)
+                    congruence(jac1, jac0_inv[e, p, k], eye, F)
+                    strain = green[e, p, k]
+                    congruence(F.T, eye, F.T, strain)
+                    for i in range(3):
+                        for j in range(3):
+                            strain[i, j] = 0.5 * (strain[i, j] - eye[i, j])

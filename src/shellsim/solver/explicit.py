@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit
 
 from ..curve_tables import factor
-from ..element import kernels
+from ..element.assembly import Assembly, assembly, internal_forces
 from ..element.frames import rotate_director
 from ..loads import external_forces
 
@@ -34,16 +34,14 @@ class Workspace(NamedTuple):
     """Scratch of the time loop, allocated once per simulation (n nodes): dx, dd (n, 3)
     the last step's mid-surface and director increments; g (n, 3) director-conjugate
     external forces; scale_pressure (P,), scale_edges (E,) the current load values;
-    parts: the element results before assembly (:class:`shellsim.element.kernels.Assembly`);
-    chunks: runs of elements the threads share out (:func:`shellsim.element.kernels.element_chunks`)."""
+    parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`)."""
 
     dx: np.ndarray
     dd: np.ndarray
     g: np.ndarray
     scale_pressure: np.ndarray
     scale_edges: np.ndarray
-    parts: kernels.Assembly
-    chunks: int
+    parts: Assembly
 
 
 def workspace(model) -> Workspace:
@@ -52,7 +50,7 @@ def workspace(model) -> Workspace:
     return Workspace(dx=np.zeros((n, 3)), dd=np.zeros((n, 3)), g=np.zeros((n, 3)),
                      scale_pressure=np.zeros(len(model.loads.pressure.elements)),
                      scale_edges=np.zeros(len(model.loads.edge_pressure.edges)),
-                     parts=kernels.assembly(n, len(model.body.conn)), chunks=kernels.element_chunks(len(model.body.conn)))
+                     parts=assembly(n, len(model.body.conn)))
 
 
 @njit(cache=True)
@@ -60,8 +58,8 @@ def forces(t, model, fields, space):
     """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
     forces of the incremental formulation take the last step's increments from ``space``."""
-    kernels.internal_forces(model.rule, model.body, model.material, fields.shape, space.dx, space.dd, fields.stress,
-                            fields.f_int, fields.fr_int, space.parts, space.chunks)
+    internal_forces(model.rule, model.body, model.material, fields.shape, space.dx, space.dd, fields.stress,
+                    fields.f_int, fields.fr_int, space.parts)
     external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g, space.scale_pressure,
                     space.scale_edges)
 

@@ -9,7 +9,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..bundles import Fields, Shape
-from ..element import kernels
+from ..element.assembly import stiffness_product
+from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
 from ..compiled_call import TypedCall
 from ..errors import NumericalError
@@ -58,8 +59,8 @@ class Simulation:
             prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(4),
             energy=np.zeros(4)))
         self.workspace = explicit.workspace(model)
-        self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(kernels.lumped_masses),
-                                 stiffness=TypedCall(kernels.stiffness_product))
+        self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
+                                 stiffness=TypedCall(stiffness_product))
         self._eigenvector: np.ndarray | None = None
         self.update_masses()
         self.evaluate_forces()

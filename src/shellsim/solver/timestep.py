@@ -1,7 +1,7 @@
 """Critical time step from the largest natural frequency (thesis 3.16).
 
 lambda_max of M^-1/2 K_L M^-1/2 on the free DOFs by Lanczos (ARPACK through scipy), with
-the stiffness applied matrix-free (:func:`shellsim.element.kernels.stiffness_product`)
+the stiffness applied matrix-free (:func:`shellsim.element.assembly.stiffness_product`)
 and warm-started from the previous estimate's eigenvector. The Ritz value approaches
 lambda_max from below, so its residual norm is added: lambda_max <= theta + |r|.
 Then dt_critical = 2 / omega_max (Eq 3.43 divides it by the safety factor).
@@ -34,8 +34,7 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None) -> tuple[float, np.
         z = np.asarray(z).ravel()
         vu = np.einsum("nij,nj->ni", projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
         vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * rot_free
-        sim.compiled.stiffness(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts,
-                               space.chunks)
+        sim.compiled.stiffness(m.rule, m.body, m.material, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts)
         out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])

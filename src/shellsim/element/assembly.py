@@ -1,0 +1,198 @@
+"""The element loop: groups of elements shared out over the threads, their forces summed
+at the nodes in one fixed order; internal forces and the stiffness product K v.
+
+Results are the same to the last bit for any number of threads: each group writes only
+its own elements' slots of an :class:`Assembly` and of the stresses, and each node then
+adds its elements' slots in ascending element order (the order of a serial loop).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import get_num_threads, njit, prange
+
+from ..materials import hyperelastic
+from .frames import director_increments, to_rotational
+from .lanes import (LANES, gather_element_values, gather_nodal_scalars, gather_nodal_vectors, group_count, group_members,
+                    scatter_element_values)
+from .response import group_response, group_scratch
+from .stress_update import INCREMENTAL, LINEAR, TOTAL
+
+
+class Assembly(NamedTuple):
+    """Per-element results before they are summed at the nodes (ne elements, n nodes):
+    fe, ge (ne, 9, 3) translational and director-conjugate forces; volume, stretch (ne,)
+    the element's volume and volume-weighted normal stretch (fibre-length update);
+    g (n, 3) the summed director-conjugate forces; chunks: how many runs of element
+    groups the threads share out (the results do not depend on it). Allocated once per
+    model (:func:`assembly`)."""
+
+    fe: np.ndarray
+    ge: np.ndarray
+    volume: np.ndarray
+    stretch: np.ndarray
+    g: np.ndarray
+    chunks: int
+
+
+def assembly(n_nodes: int, n_elements: int) -> Assembly:
+    """An :class:`Assembly` for a mesh of that size, one run of groups per thread (fewer
+    on a tiny mesh)."""
+    chunks = max(1, min(group_count(n_elements), get_num_threads()))
+    return Assembly(fe=np.zeros((n_elements, 9, 3)), ge=np.zeros((n_elements, 9, 3)), volume=np.zeros(n_elements),
+                    stretch=np.zeros(n_elements), g=np.zeros((n_nodes, 3)), chunks=chunks)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stress, f, fr, parts):
+    """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
+
+    mode: of :mod:`shellsim.element.stress_update`; ux, ud (n, 3) the field's
+    translations and director increments (INCREMENTAL, LINEAR); stress (ne, nq, nt, 5)
+    written (read too when INCREMENTAL); state_stress: the current stress (LINEAR).
+
+    With Techniques 2 and 3 (INCREMENTAL mode), the fibre lengths are scaled each step by
+    1 + the step's normal strain increment (thesis Eq 3.33); with a hyperelastic law in
+    TOTAL mode the initial ones by the normal stretch, h = h0 lambda_3 (thesis 3.11), one
+    step behind the kinematics as in the thesis. Either factor is the element's volume
+    mean, and a node takes the volume-weighted mean of its elements': averaged from the
+    integration points with weights N_a dv, or N_a^2 dv, the nodal lengths of a refined
+    holed sheet (Techniques 2, 3) grew a pattern inside the elements next to the hole
+    that broke the run down. The stresses of a hyperelastic law are computed on the
+    initial fibre lengths: J = 1 fixes the thickness strain anyway, and with the current
+    ones a node-to-node difference in h tilts the layers, strains them and feeds back
+    into lambda_3 (a loop no energy stands behind, which broke Test 10 down). The updated
+    h moves the faces (pressure, probes), masses and volume.
+    """
+    hyper = material.law != hyperelastic.LINEAR
+    groups = -(-body.conn.shape[0] // LANES)
+    chunks = parts.chunks
+    incremental_update = material.technique >= 2 and mode == INCREMENTAL
+    update = material.thickness_update and ((hyper and mode == TOTAL) or incremental_update)
+    # the chunks' bodies run in a function of their own: a nested bundle cannot cross into
+    # a prange body, and code written inline there was compiled wrongly
+    for c in prange(chunks):
+        _group_run(c * groups // chunks, (c + 1) * groups // chunks, mode, rule, body, material, shape, ux, ud, stress,
+                   state_stress, parts, update)
+    _gather_at_nodes(body, parts, f)
+    to_rotational(parts.g, shape.d, shape.e1, fr)
+    if update:
+        _update_fibre_lengths(body, parts, shape.h, incremental_update)
+
+
+@njit(cache=True, error_model="numpy")
+def _group_run(start, stop, mode, rule, body, material, shape, ux, ud, stress, state_stress, parts, update):
+    """The responses of groups start..stop-1 into their elements' slots of ``parts`` and
+    ``stress``; arguments as :func:`_all_elements`, ``update``: whether the fibre lengths
+    follow (element volumes and mean stretches are then kept)."""
+    conn = body.conn
+    ne = conn.shape[0]
+    nq, nt = rule.wq.shape[0], rule.tz.shape[0]
+    work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
+    members = work.members
+    fe, ge = np.empty((9, 3, LANES)), np.empty((9, 3, LANES))
+    lengths = body.h0 if material.law != hyperelastic.LINEAR else shape.h
+    for group in range(start, stop):
+        count = group_members(group, ne, members)
+        gather_nodal_vectors(conn, members, shape.x, work.xe)
+        gather_nodal_vectors(conn, members, shape.d, work.de)
+        gather_nodal_scalars(conn, members, lengths, work.he)
+        gather_element_values(body.jac0_inv, members, work.jac0)
+        if mode != TOTAL:
+            gather_nodal_vectors(conn, members, ux, work.ue)
+            gather_nodal_vectors(conn, members, ud, work.ve)
+        if mode == INCREMENTAL:
+            gather_element_values(stress, members, work.stress)
+        if mode == LINEAR:
+            gather_element_values(state_stress, members, work.state_stress)
+        group_response(mode, rule, material, work, count, fe, ge)
+        scatter_element_values(work.stress, members, count, stress)
+        for lane in range(count):
+            e = members[lane]
+            for a in range(9):
+                for i in range(3):
+                    parts.fe[e, a, i] = fe[a, i, lane]
+                    parts.ge[e, a, i] = ge[a, i, lane]
+            if update:
+                volume = 0.0
+                mean = 0.0
+                for p in range(nq):
+                    dv = 0.0
+                    for k in range(nt):
+                        dv += work.DV[p, k, lane]
+                    volume += dv
+                    mean += dv * work.stretch[p, lane]
+                parts.volume[e] = volume
+                parts.stretch[e] = mean
+
+
+@njit(cache=True, error_model="numpy")
+def _gather_at_nodes(body, parts, f):
+    """The nodal sums of the element forces in ``parts`` (:class:`Assembly`), each node's
+    slots in ascending order: f (n, 3) from fe, parts.g from ge."""
+    g = parts.g
+    for node in range(g.shape[0]):
+        f[node, :] = 0.0
+        g[node, :] = 0.0
+        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
+            e, a = divmod(body.slots[slot], 9)
+            for i in range(3):
+                f[node, i] += parts.fe[e, a, i]
+                g[node, i] += parts.ge[e, a, i]
+
+
+@njit(cache=True, error_model="numpy")
+def _update_fibre_lengths(body, parts, h, incremental):
+    """h (n,) = (h, incremental; else h0) x the volume-weighted mean of the normal
+    stretches of the node's elements (``parts``), summed in ascending element order."""
+    for node in range(h.shape[0]):
+        weighted = 0.0
+        weights = 0.0
+        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
+            e = body.slots[slot] // 9
+            weighted += parts.stretch[e]
+            weights += parts.volume[e]
+        if weights > 0.0:
+            h[node] = (h[node] if incremental else body.h0[node]) * weighted / weights
+
+
+@njit(cache=True, error_model="numpy")
+def internal_forces(rule, body, material, shape, dx, dd, stress, f, fr, parts):
+    """Internal forces of all elements at the current configuration.
+
+    Parameters
+    ----------
+    rule, body, material : :class:`shellsim.bundles.Rule`, :class:`~shellsim.bundles.Body`,
+        :class:`~shellsim.bundles.Material`. In the total formulation the stress follows
+        from the total deformation (Almansi strain, thesis Eq 3.1 and 3.22); in the
+        incremental one (``material.incremental``) the stress in the lamina frame gains
+        C~ times the strain increment of the last step (Eq 3.2).
+    shape : :class:`~shellsim.bundles.Shape`, the current configuration; its fibre lengths
+        h are updated in place when the material asks (see :func:`_all_elements`).
+    dx, dd : (n, 3) last step's mid-surface and director increments (incremental only).
+    stress : (ne, nq, nt, 5) lamina Cauchy stress, written (and read when incremental).
+    f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
+    parts : :class:`Assembly` of the mesh (scratch).
+    """
+    _all_elements(INCREMENTAL if material.incremental else TOTAL, rule, body, material, shape, dx, dd, stress, stress,
+                  f, fr, parts)
+
+
+@njit(cache=True, error_model="numpy")
+def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts):
+    """Tangent stiffness times a DOF vector, K v, without forming K: the material part
+    K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
+    Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
+    thesis leaves out but a membrane stretched to large strain needs (Test 8: the step
+    from K_L alone was too long on refined meshes).
+
+    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
+    fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
+    loop's: it is scratch between steps).
+    """
+    vd = np.empty((shape.x.shape[0], 3))
+    director_increments(vr, shape.d, shape.e1, vd)
+    field_stress = np.empty((body.conn.shape[0], rule.wq.shape[0], rule.tz.shape[0], 5))
+    _all_elements(LINEAR, rule, body, material, shape, vu, vd, field_stress, stress, f, fr, parts)

@@ -65,6 +65,14 @@ def forces(t, model, fields, space):
 
 
 @njit(cache=True)
+def equal_step(remaining, dt):
+    """The step that covers ``remaining`` time in equal steps no longer than ``dt``: a
+    single shortened last step would alternate long and short steps at every stop, which
+    pumps energy into the highest modes when dt is near the critical step."""
+    return remaining / max(1.0, np.ceil(remaining / dt - 1e-9))
+
+
+@njit(cache=True)
 def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     """Take central-difference steps of size ``dt`` until ``t_stop`` or ``max_steps``.
 
@@ -91,11 +99,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     a = np.empty(3)
     steps = 0
     while steps < max_steps and t < t_stop:
-        # Equal steps no longer than dt up to t_stop: a single shortened last step would
-        # alternate long and short steps at every stop, which pumps energy into the
-        # highest modes when dt is near the critical step.
-        remaining = t_stop - t
-        step = remaining / max(1.0, np.ceil(remaining / dt - 1e-9))
+        step = equal_step(t_stop - t, dt)
         dt_avg = 0.5 * (dt_prev + step)
         c = damping * dt_avg
         work_ext = 0.0

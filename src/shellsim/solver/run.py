@@ -19,7 +19,7 @@ from ..element.sampling import nearest_integration_point, pressure_band, thickne
 from ..errors import NumericalError
 from ..mesh import Mesh
 from ..model import FACES, Model
-from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
+from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
 from .simulation import Simulation
 
 #: History samples over a run (fewer when the run has fewer steps).
@@ -268,11 +268,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
         history_interval = solver.end_time / HISTORY_SAMPLES
         for landing in output_times(run.deck):
             while sim.state.t < landing:
-                # Equal steps up to the next output time, history samples on whole steps:
-                # a short step among long ones near the critical step pumps energy into
-                # the highest modes.
-                remaining = landing - sim.state.t
-                step = remaining / max(1.0, math.ceil(remaining / run.dt - 1e-9))
+                # equal steps up to the next output time, history samples on whole steps
+                step = equal_step(landing - sim.state.t, run.dt)
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
                 while sim.state.t < target:
                     try:

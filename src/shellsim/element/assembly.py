@@ -15,8 +15,7 @@ from numba import get_num_threads, njit, prange
 
 from ..materials import hyperelastic
 from .frames import director_increments, to_rotational
-from .lanes import (LANES, gather_element_values, gather_nodal_scalars, gather_nodal_vectors, group_count, group_members,
-                    scatter_element_values)
+from .lanes import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_response, group_scratch
 from .stress_update import INCREMENTAL, LINEAR, TOTAL
 
@@ -51,7 +50,8 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
 
     mode: of :mod:`shellsim.element.stress_update`; ux, ud (n, 3) the field's
     translations and director increments (INCREMENTAL, LINEAR); stress (ne, nq, nt, 5)
-    written (read too when INCREMENTAL); state_stress: the current stress (LINEAR).
+    written (read too when INCREMENTAL; untouched when LINEAR); state_stress: the current
+    stress (LINEAR).
 
     With Techniques 2 and 3 (INCREMENTAL mode), the fibre lengths are scaled each step by
     1 + the step's normal strain increment (thesis Eq 3.33); with a hyperelastic law in
@@ -67,7 +67,7 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
     h moves the faces (pressure, probes), masses and volume.
     """
     hyper = material.law != hyperelastic.LINEAR
-    groups = -(-body.conn.shape[0] // LANES)
+    groups = group_count(body.conn.shape[0])
     chunks = parts.chunks
     incremental_update = material.technique >= 2 and mode == INCREMENTAL
     update = material.thickness_update and ((hyper and mode == TOTAL) or incremental_update)
@@ -88,17 +88,12 @@ def _group_run(start, stop, mode, rule, body, material, shape, ux, ud, stress, s
     ``stress``; arguments as :func:`_all_elements`, ``update``: whether the fibre lengths
     follow (element volumes and mean stretches are then kept)."""
     conn = body.conn
-    ne = conn.shape[0]
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
     work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
     members = work.members
-    fe, ge = np.empty((9, 3, LANES)), np.empty((9, 3, LANES))
     lengths = body.h0 if material.law != hyperelastic.LINEAR else shape.h
     for group in range(start, stop):
-        count = group_members(group, ne, members)
-        gather_nodal_vectors(conn, members, shape.x, work.xe)
-        gather_nodal_vectors(conn, members, shape.d, work.de)
-        gather_nodal_scalars(conn, members, lengths, work.he)
+        count = gather_shape(group, conn, shape.x, shape.d, lengths, members, work.xe, work.de, work.he)
         gather_element_values(body.jac0_inv, members, work.jac0)
         if mode != TOTAL:
             gather_nodal_vectors(conn, members, ux, work.ue)
@@ -107,14 +102,15 @@ def _group_run(start, stop, mode, rule, body, material, shape, ux, ud, stress, s
             gather_element_values(stress, members, work.stress)
         if mode == LINEAR:
             gather_element_values(state_stress, members, work.state_stress)
-        group_response(mode, rule, material, work, count, fe, ge)
-        scatter_element_values(work.stress, members, count, stress)
+        group_response(mode, rule, material, work, count)
+        if mode != LINEAR:  # the K v product's stresses are the field's, of no use after
+            scatter_element_values(work.stress, members, count, stress)
         for lane in range(count):
             e = members[lane]
             for a in range(9):
                 for i in range(3):
-                    parts.fe[e, a, i] = fe[a, i, lane]
-                    parts.ge[e, a, i] = ge[a, i, lane]
+                    parts.fe[e, a, i] = work.fe[a, i, lane]
+                    parts.ge[e, a, i] = work.ge[a, i, lane]
             if update:
                 volume = 0.0
                 mean = 0.0
@@ -194,5 +190,4 @@ def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts)
     """
     vd = np.empty((shape.x.shape[0], 3))
     director_increments(vr, shape.d, shape.e1, vd)
-    field_stress = np.empty((body.conn.shape[0], rule.wq.shape[0], rule.tz.shape[0], 5))
-    _all_elements(LINEAR, rule, body, material, shape, vu, vd, field_stress, stress, f, fr, parts)
+    _all_elements(LINEAR, rule, body, material, shape, vu, vd, stress, stress, f, fr, parts)

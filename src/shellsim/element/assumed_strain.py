@@ -59,12 +59,9 @@ def _solve2(a00, a01, a10, a11, b0, b1, out0, out1):
 @njit(cache=True, error_model="numpy")
 def tie_membrane(rule, work, nq, nt):
     """Replace the membrane part of the lamina strains work.EPS at the Gauss points by
-    its tied interpolation."""
-    tie, tie_points, wt = rule.tie, rule.tie_points, rule.wt
+    its tied interpolation (the through-thickness means weighted by work.share)."""
+    tie, tie_points, share = rule.tie, rule.tie_points, work.share
     EPS, Q, G, cbar, plane, glob, local, delta = work.EPS, work.Q, work.G, work.cbar, work.plane, work.glob, work.local, work.delta
-    wsum = 0.0
-    for k in range(nt):
-        wsum += wt[k]
     # covariant membrane strains c_ab = g_a . eps . g_b (frame-free) and their
     # through-thickness means cbar at every point
     cbar[:] = 0.0
@@ -83,7 +80,7 @@ def tie_membrane(rule, work, nq, nt):
                     for i in range(3):
                         for j in range(3):
                             acc += g[a, i, lane] * glob[i, j, lane] * g[b, j, lane]
-                    cbar[x, c, lane] += wt[k] / wsum * acc
+                    cbar[x, c, lane] += share[k] * acc
     for p in range(nq):
         for c in range(3):
             for lane in range(LANES):

@@ -11,11 +11,10 @@ from numba import njit
 
 
 @njit(cache=True, inline="always")
-def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
-    """out = a x b, all (3,)."""
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+def cross(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """The components of a x b, a and b (3,) (rows of nodal arrays too: nothing is
+    allocated)."""
+    return a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]
 
 
 @njit(cache=True, inline="always")
@@ -44,9 +43,9 @@ def initial_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     axis = np.zeros(3)
     axis[j] = 1.0
     e2 = np.empty(3)
-    cross(d, axis, e2)
+    e2[0], e2[1], e2[2] = cross(d, axis)
     normalize(e2)
-    cross(e2, d, e1)
+    e1[0], e1[1], e1[2] = cross(e2, d)
 
 
 @njit(cache=True, error_model="numpy")
@@ -57,7 +56,7 @@ def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     sense through any rotation (bending past 90 degrees no longer flips it). e1 (3,) is
     updated in place. Scalars only: it runs at every node of every step.
     """
-    e2x, e2y, e2z = d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]
+    e2x, e2y, e2z = cross(d, e1)
     n = np.sqrt(e2x * e2x + e2y * e2y + e2z * e2z)
     e2x, e2y, e2z = e2x / n, e2y / n, e2z / n
     e1[0] = e2y * d[2] - e2z * d[1]
@@ -70,7 +69,7 @@ def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: floa
     """Director update by trial increment and normalisation (thesis 3.2, Eq 2.62):
     d <- (d - dtheta1 e1f - dtheta2 e2f) / |...|, e2f = d x e1f, then the fibre frame
     follows. In place."""
-    e2x, e2y, e2z = d[1] * e1[2] - d[2] * e1[1], d[2] * e1[0] - d[0] * e1[2], d[0] * e1[1] - d[1] * e1[0]
+    e2x, e2y, e2z = cross(d, e1)
     d[0] -= dtheta1 * e1[0] + dtheta2 * e2x
     d[1] -= dtheta1 * e1[1] + dtheta2 * e2y
     d[2] -= dtheta1 * e1[2] + dtheta2 * e2z
@@ -83,9 +82,7 @@ def to_rotational(g, d, e1, out):
     """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
     (-e1f.g, -e2f.g), e2f = d x e1f."""
     for n in range(g.shape[0]):
-        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
-        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
-        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        e2x, e2y, e2z = cross(d[n], e1[n])
         out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
         out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
 
@@ -94,9 +91,7 @@ def to_rotational(g, d, e1, out):
 def director_increments(w, d, e1, out):
     """Director increments (n, 3) of rotational DOF values w (n, 2): -w1 e1f - w2 e2f."""
     for n in range(w.shape[0]):
-        e2x = d[n, 1] * e1[n, 2] - d[n, 2] * e1[n, 1]
-        e2y = d[n, 2] * e1[n, 0] - d[n, 0] * e1[n, 2]
-        e2z = d[n, 0] * e1[n, 1] - d[n, 1] * e1[n, 0]
+        e2x, e2y, e2z = cross(d[n], e1[n])
         out[n, 0] = -w[n, 0] * e1[n, 0] - w[n, 1] * e2x
         out[n, 1] = -w[n, 0] * e1[n, 1] - w[n, 1] * e2y
         out[n, 2] = -w[n, 0] * e1[n, 2] - w[n, 1] * e2z

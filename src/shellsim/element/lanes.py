@@ -20,7 +20,8 @@ from numba import njit
 LANES = 16
 
 
-def group_count(n_elements: int) -> int:
+@njit(cache=True)
+def group_count(n_elements):
     """Groups covering ``n_elements`` elements."""
     return -(-n_elements // LANES)
 
@@ -33,6 +34,18 @@ def group_members(group, ne, members):
     for lane in range(LANES):
         members[lane] = min(start + lane, ne - 1)
     return min(LANES, ne - start)
+
+
+@njit(cache=True, error_model="numpy")
+def gather_shape(group, conn, x, d, h, members, xe, de, he):
+    """A group's members (:func:`group_members`) and their positions and directors
+    xe, de (9, 3, G) and fibre lengths he (9, G) from the nodal x, d (n, 3) and h (n,);
+    returns how many lanes hold elements of their own."""
+    count = group_members(group, conn.shape[0], members)
+    gather_nodal_vectors(conn, members, x, xe)
+    gather_nodal_vectors(conn, members, d, de)
+    gather_nodal_scalars(conn, members, h, he)
+    return count
 
 
 @njit(cache=True, error_model="numpy")

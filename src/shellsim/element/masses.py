@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 from .kinematics import point_geometry
-from .lanes import LANES, gather_nodal_scalars, gather_nodal_vectors, group_members, lane_copy
+from .lanes import LANES, gather_shape, group_count, lane_copy
 
 
 @njit(cache=True, error_model="numpy")
@@ -25,7 +25,6 @@ def lumped_masses(rule, body, shape, density, hughes, mt, mr):
     """
     conn = body.conn
     N, dNr, dNs, wq, tz, wt = rule.N, rule.dNr, rule.dNs, rule.wq, rule.tz, rule.wt
-    ne = conn.shape[0]
     mt[:] = 0.0
     mr[:] = 0.0
     members = np.empty(LANES, dtype=np.int64)
@@ -33,11 +32,8 @@ def lumped_masses(rule, body, shape, density, hughes, mt, mr):
     jac, jinv, q, det = np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty(LANES)
     raw, rot, volume = np.empty((9, LANES)), np.empty((9, LANES)), np.empty(LANES)
     raw1, rot1, he1 = np.empty(9), np.empty(9), np.empty(9)
-    for group in range(-(-ne // LANES)):
-        count = group_members(group, ne, members)
-        gather_nodal_vectors(conn, members, shape.x, xe)
-        gather_nodal_vectors(conn, members, shape.d, de)
-        gather_nodal_scalars(conn, members, shape.h, he)
+    for group in range(group_count(conn.shape[0])):
+        count = gather_shape(group, conn, shape.x, shape.d, shape.h, members, xe, de, he)
         raw[:] = 0.0
         rot[:] = 0.0
         volume[:] = 0.0

@@ -30,7 +30,7 @@ class GroupScratch(NamedTuple):
     directors and the field's increments, he (9, G) fibre lengths; jac0 (npts, nt, 3, 3, G)
     inverse initial Jacobians; stress, state_stress (nq, nt, 5, G) lamina stresses (the
     response's, and the state's for the initial-stress stiffness); stretch (nq, G) normal
-    stretches.
+    stretches; fe, ge (9, 3, G) the nodal forces.
     At one point (3, 3, G): jac, F, eg, v, plane, glob, local, sg; gN, gM (9, 3, G);
     s5 (5, G); cov, delta (3, G); det (G,); ones (G,) of 1.0.
     At every point (npts, nt, ...): Q, jinv_all (3, 3, G) lamina frames and inverse
@@ -55,6 +55,8 @@ class GroupScratch(NamedTuple):
     stress: np.ndarray
     state_stress: np.ndarray
     stretch: np.ndarray
+    fe: np.ndarray
+    ge: np.ndarray
     jac: np.ndarray
     F: np.ndarray
     eg: np.ndarray
@@ -108,7 +110,7 @@ def group_scratch(npts, nt, nq, nb):
     return GroupScratch(
         members=np.zeros(g, dtype=np.int64), xe=np.empty((9, 3, g)), de=np.empty((9, 3, g)), ue=np.zeros((9, 3, g)),
         ve=np.zeros((9, 3, g)), he=np.empty((9, g)), jac0=np.empty((npts, nt, 3, 3, g)), stress=np.zeros((nq, nt, 5, g)),
-        state_stress=np.zeros((nq, nt, 5, g)), stretch=np.ones((nq, g)),
+        state_stress=np.zeros((nq, nt, 5, g)), stretch=np.ones((nq, g)), fe=np.empty((9, 3, g)), ge=np.empty((9, 3, g)),
         jac=np.empty((3, 3, g)), F=np.empty((3, 3, g)), eg=np.empty((3, 3, g)), v=np.empty((3, 3, g)),
         plane=np.zeros((3, 3, g)), glob=np.empty((3, 3, g)), local=np.empty((3, 3, g)), sg=np.empty((3, 3, g)),
         gN=np.empty((9, 3, g)), gM=np.empty((9, 3, g)), s5=np.empty((5, g)), cov=np.empty((3, g)), delta=np.empty((3, g)),
@@ -124,8 +126,8 @@ def group_scratch(npts, nt, nq, nb):
 
 
 @njit(cache=True, error_model="numpy")
-def group_response(mode, rule, material, work, count, fe, ge):
-    """Stresses work.stress and nodal forces fe, ge (9, 3, G) of the group gathered in
+def group_response(mode, rule, material, work, count):
+    """Stresses work.stress and nodal forces work.fe, work.ge (9, 3, G) of the group gathered in
     ``work``, whose first ``count`` lanes hold elements of their own (the per-lane laws
     skip the others), with assumed membrane and shear strains (:mod:`shellsim.element.assumed_strain`).
 
@@ -217,6 +219,7 @@ def group_response(mode, rule, material, work, count, fe, ge):
     shear_tying_stresses(rule, work, stress, nq, nt)
     # 5. nodal forces: the direct stresses at the Gauss points, the tied shears and
     # membrane weights at every point
+    fe, ge = work.fe, work.ge
     _point_forces(rule, work, nq, share, fe, ge)
     if mode == LINEAR:
         # initial-stress stiffness: the current stress sigma acting through the field's

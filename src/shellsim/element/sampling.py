@@ -8,7 +8,7 @@ from numba import njit
 
 from ..tensor3 import congruence
 from .kinematics import global_stress, point_geometry
-from .lanes import LANES, gather_nodal_scalars, gather_nodal_vectors, group_members, lane_copy
+from .lanes import LANES, gather_shape, group_count, lane_copy
 
 
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,
@@ -45,7 +45,6 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     ``green``, the Green-Lagrange strain (F^T F - I) / 2 in global axes with
     F = dx/d(r, s, t) (dX/d(r, s, t))^-1.
     """
-    ne = conn.shape[0]
     members = np.empty(LANES, dtype=np.int64)
     xe, de, he = np.empty((9, 3, LANES)), np.empty((9, 3, LANES)), np.empty((9, LANES))
     jac, jinv, q, det = np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty(LANES)
@@ -53,11 +52,8 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     for i in range(3):
         same[i, i, :] = 1.0  # the lamina frame is its own
     jac1, F, eye = np.empty((3, 3)), np.empty((3, 3)), np.eye(3)
-    for group in range(-(-ne // LANES)):
-        count = group_members(group, ne, members)
-        gather_nodal_vectors(conn, members, x, xe)
-        gather_nodal_vectors(conn, members, d, de)
-        gather_nodal_scalars(conn, members, h, he)
+    for group in range(group_count(conn.shape[0])):
+        count = gather_shape(group, conn, x, d, h, members, xe, de, he)
         for p in range(N.shape[0]):
             for k in range(tz.shape[0]):
                 point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, det)

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..element.frames import cross
+
 #: 3-point Gauss rule along an element edge and the 1D quadratic shape functions at its
 #: points, for (corner, mid-side, corner) node triples.
 EDGE_XI = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
@@ -36,9 +38,7 @@ def edge_pressure_forces(shape, loads, scale, f):
                     tan[i] += EDGE_DN[p, k] * x[node, i]
                     nrm[i] += EDGE_N[p, k] * d[node, i]
             nrm /= np.sqrt(nrm @ nrm)
-            out[0] = tan[1] * nrm[2] - tan[2] * nrm[1]
-            out[1] = tan[2] * nrm[0] - tan[0] * nrm[2]
-            out[2] = tan[0] * nrm[1] - tan[1] * nrm[0]
+            out[0], out[1], out[2] = cross(tan, nrm)
             for k in range(3):
                 node = loads.edges[m, k]
                 w = -loads.outward[m] * scale[m] * thick * EDGE_N[p, k] * EDGE_W[p]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..element.frames import cross
+
 
 @njit(cache=True)
 def pressure_forces(rule, conn, shape, faces, scale, f, g):
@@ -36,9 +38,7 @@ def pressure_forces(rule, conn, shape, faces, scale, f, g):
                     pos = x[node, i] + t * 0.5 * h[node] * d[node, i]
                     yr[i] += dNr[p, a] * pos
                     ys[i] += dNs[p, a] * pos
-            area[0] = yr[1] * ys[2] - yr[2] * ys[1]
-            area[1] = yr[2] * ys[0] - yr[0] * ys[2]
-            area[2] = yr[0] * ys[1] - yr[1] * ys[0]
+            area[0], area[1], area[2] = cross(yr, ys)
             for a in range(9):
                 node = conn[e, a]
                 w = sign * scale[m] * N[p, a] * wq[p]

@@ -21,8 +21,8 @@ from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, sha
 from .errors import NotYetAvailable
 from .loads.edge_pressure import EDGE_DN, EDGE_N, EDGE_W
 from .loads.pressure import pressure_forces
-from .materials import hyperelastic
-from .materials.linear import SHEAR_FACTOR, reduced_lamina_matrix
+from .materials.laws import law_of
+from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -106,7 +106,7 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
     material, section = deck.material, deck.section
     nq = len(rule.wq)
     no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
-    constant = dict(law=hyperelastic.LINEAR, params=np.zeros(4), axes0=no_axes, normal_ratio=0.0)
+    constant = dict(law=0, params=np.zeros(1), incompressible=False, axes0=no_axes, normal_ratio=0.0)
     if not material.HYPERELASTIC and section.technique is None:
         return Material(C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), technique=0,
                         incremental=section.formulation == "incremental", thickness_update=False, **constant)
@@ -124,16 +124,11 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
                               "Technique 1; Techniques 2 and 3 take a linear elastic material")
     if section.formulation != "total":
         raise NotYetAvailable("Technique 1 runs in the total formulation (section.formulation = 'total')")
-    if material.model == "linear_elastic":
-        lam = material.E * material.nu / ((1 + material.nu) * (1 - 2 * material.nu))
-        law, params = hyperelastic.ST_VENANT_KIRCHHOFF, [lam, material.E / (2 * (1 + material.nu)), SHEAR_FACTOR, 0.0]
-    elif material.model == "guccione":
-        law, params = hyperelastic.GUCCIONE, [material.C1, material.C2, material.C3, material.C4]
-    else:
-        law, params = hyperelastic.MOONEY_RIVLIN, [material.C1, getattr(material, "C2", 0.0), 0.0, 0.0]
+    code, law = law_of(material.model)
     axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
-    return Material(law=law, params=np.asarray(params, dtype=float), C=np.zeros((5, 5)), axes0=axes0, technique=1,
-                    normal_ratio=0.0, incremental=False, thickness_update=deck.thickness_update)
+    return Material(law=code, params=law.parameters(material), incompressible=law.INCOMPRESSIBLE, C=np.zeros((5, 5)),
+                    axes0=axes0, technique=1, normal_ratio=0.0, incremental=False,
+                    thickness_update=deck.thickness_update)
 
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:

@@ -1,26 +1,68 @@
-"""3 x 3 algebra for the compiled kernels: scalar loops, no allocation, one point at a
-time (numba)."""
+"""3 x 3 algebra over an element group's lanes: every array (3, 3, G) holds one matrix per
+lane, G = :data:`shellsim.element.lanes.LANES` the last axis, so each line is a packed
+loop over the lanes. The helpers are inlined into their callers (a call's argument
+passing would cost as much as the arithmetic); none allocates, and an ``out`` must be
+none of the inputs."""
 
 from __future__ import annotations
 
 from numba import njit
 
-
-@njit(cache=True, error_model="numpy")
-def det3(A):
-    """Determinant of A (3, 3)."""
-    return (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
-            - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
-            + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
+from .element.lanes import LANES
 
 
-@njit(cache=True, error_model="numpy")
-def congruence(a, m, b, out):
-    """out = a m b^T, all (3, 3); out must be none of the inputs. With a = b = q it turns
-    a global tensor into the frame q (rows: its axes), with q.T back."""
+@njit(cache=True, error_model="numpy", inline="always")
+def det3(A, out):
+    """out (G,) = det A, A (3, 3, G)."""
+    for lane in range(LANES):
+        out[lane] = (A[0, 0, lane] * (A[1, 1, lane] * A[2, 2, lane] - A[1, 2, lane] * A[2, 1, lane])
+                     - A[0, 1, lane] * (A[1, 0, lane] * A[2, 2, lane] - A[1, 2, lane] * A[2, 0, lane])
+                     + A[0, 2, lane] * (A[1, 0, lane] * A[2, 1, lane] - A[1, 1, lane] * A[2, 0, lane]))
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def product(A, B, out):
+    """out = A B, all (3, 3, G); out must be neither input."""
     for i in range(3):
-        r0 = a[i, 0] * m[0, 0] + a[i, 1] * m[1, 0] + a[i, 2] * m[2, 0]
-        r1 = a[i, 0] * m[0, 1] + a[i, 1] * m[1, 1] + a[i, 2] * m[2, 1]
-        r2 = a[i, 0] * m[0, 2] + a[i, 1] * m[1, 2] + a[i, 2] * m[2, 2]
         for j in range(3):
-            out[i, j] = r0 * b[j, 0] + r1 * b[j, 1] + r2 * b[j, 2]
+            for lane in range(LANES):
+                out[i, j, lane] = 0.0
+            for m in range(3):
+                for lane in range(LANES):
+                    out[i, j, lane] += A[i, m, lane] * B[m, j, lane]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def product_transposed(A, B, out):
+    """out = A B^T, all (3, 3, G)."""
+    for i in range(3):
+        for j in range(3):
+            for lane in range(LANES):
+                out[i, j, lane] = 0.0
+            for m in range(3):
+                for lane in range(LANES):
+                    out[i, j, lane] += A[i, m, lane] * B[j, m, lane]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def to_lamina(q, A, out):
+    """out = q A q^T, all (3, 3, G): a global tensor's lamina components."""
+    for i in range(3):
+        for lane in range(LANES):
+            r0 = q[i, 0, lane] * A[0, 0, lane] + q[i, 1, lane] * A[1, 0, lane] + q[i, 2, lane] * A[2, 0, lane]
+            r1 = q[i, 0, lane] * A[0, 1, lane] + q[i, 1, lane] * A[1, 1, lane] + q[i, 2, lane] * A[2, 1, lane]
+            r2 = q[i, 0, lane] * A[0, 2, lane] + q[i, 1, lane] * A[1, 2, lane] + q[i, 2, lane] * A[2, 2, lane]
+            for j in range(3):
+                out[i, j, lane] = r0 * q[j, 0, lane] + r1 * q[j, 1, lane] + r2 * q[j, 2, lane]
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def to_global(q, A, out):
+    """out = q^T A q, all (3, 3, G): a lamina tensor in global axes."""
+    for i in range(3):
+        for lane in range(LANES):
+            r0 = q[0, i, lane] * A[0, 0, lane] + q[1, i, lane] * A[1, 0, lane] + q[2, i, lane] * A[2, 0, lane]
+            r1 = q[0, i, lane] * A[0, 1, lane] + q[1, i, lane] * A[1, 1, lane] + q[2, i, lane] * A[2, 1, lane]
+            r2 = q[0, i, lane] * A[0, 2, lane] + q[1, i, lane] * A[1, 2, lane] + q[2, i, lane] * A[2, 2, lane]
+            for j in range(3):
+                out[i, j, lane] = r0 * q[0, j, lane] + r1 * q[1, j, lane] + r2 * q[2, j, lane]

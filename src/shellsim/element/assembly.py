@@ -13,7 +13,6 @@ from typing import NamedTuple
 import numpy as np
 from numba import get_num_threads, njit, prange
 
-from ..materials import hyperelastic
 from .frames import director_increments, to_rotational
 from .lanes import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_response, group_scratch
@@ -66,7 +65,7 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
     into lambda_3 (a loop no energy stands behind, which broke Test 10 down). The updated
     h moves the faces (pressure, probes), masses and volume.
     """
-    hyper = material.law != hyperelastic.LINEAR
+    hyper = material.technique == 1
     groups = group_count(body.conn.shape[0])
     chunks = parts.chunks
     incremental_update = material.technique >= 2 and mode == INCREMENTAL
@@ -91,10 +90,13 @@ def _group_run(start, stop, mode, rule, body, material, shape, ux, ud, stress, s
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
     work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
     members = work.members
-    lengths = body.h0 if material.law != hyperelastic.LINEAR else shape.h
+    hyper = material.technique == 1
+    lengths = body.h0 if hyper else shape.h
     for group in range(start, stop):
         count = gather_shape(group, conn, shape.x, shape.d, lengths, members, work.xe, work.de, work.he)
         gather_element_values(body.jac0_inv, members, work.jac0)
+        if hyper:
+            gather_element_values(material.axes0, members, work.axes0)
         if mode != TOTAL:
             gather_nodal_vectors(conn, members, ux, work.ue)
             gather_nodal_vectors(conn, members, ud, work.ve)

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .kinematics import to_global, to_lamina
+from ..tensor3 import to_global, to_lamina
 from .lanes import LANES
 
 

@@ -28,16 +28,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ..tensor3 import det3
 from .lanes import LANES
 
-
-@njit(cache=True, error_model="numpy", inline="always")
-def det3(A, out):
-    """out (G,) = det A, A (3, 3, G)."""
-    for lane in range(LANES):
-        out[lane] = (A[0, 0, lane] * (A[1, 1, lane] * A[2, 2, lane] - A[1, 2, lane] * A[2, 1, lane])
-                     - A[0, 1, lane] * (A[1, 0, lane] * A[2, 2, lane] - A[1, 2, lane] * A[2, 0, lane])
-                     + A[0, 2, lane] * (A[1, 0, lane] * A[2, 1, lane] - A[1, 1, lane] * A[2, 0, lane]))
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -114,17 +107,6 @@ def gradient_vectors(jinv, he, N, dNr, dNs, t, gN, gM):
                 gM[a, j, lane] = 0.5 * he[a, lane] * (t * g + jinv[2, j, lane] * N[a])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def product(A, B, out):
-    """out = A B, all (3, 3, G); out must be neither input."""
-    for i in range(3):
-        for j in range(3):
-            for lane in range(LANES):
-                out[i, j, lane] = 0.0
-            for m in range(3):
-                for lane in range(LANES):
-                    out[i, j, lane] += A[i, m, lane] * B[m, j, lane]
-
 
 @njit(cache=True, error_model="numpy", inline="always")
 def almansi(F, eg, B, det):
@@ -168,28 +150,6 @@ def symmetric_part(L, out):
                 out[i, j, lane] = 0.5 * (L[i, j, lane] + L[j, i, lane])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def to_lamina(q, A, out):
-    """out = q A q^T, all (3, 3, G): a global tensor's lamina components."""
-    for i in range(3):
-        for lane in range(LANES):
-            r0 = q[i, 0, lane] * A[0, 0, lane] + q[i, 1, lane] * A[1, 0, lane] + q[i, 2, lane] * A[2, 0, lane]
-            r1 = q[i, 0, lane] * A[0, 1, lane] + q[i, 1, lane] * A[1, 1, lane] + q[i, 2, lane] * A[2, 1, lane]
-            r2 = q[i, 0, lane] * A[0, 2, lane] + q[i, 1, lane] * A[1, 2, lane] + q[i, 2, lane] * A[2, 2, lane]
-            for j in range(3):
-                out[i, j, lane] = r0 * q[j, 0, lane] + r1 * q[j, 1, lane] + r2 * q[j, 2, lane]
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def to_global(q, A, out):
-    """out = q^T A q, all (3, 3, G): a lamina tensor in global axes."""
-    for i in range(3):
-        for lane in range(LANES):
-            r0 = q[0, i, lane] * A[0, 0, lane] + q[1, i, lane] * A[1, 0, lane] + q[2, i, lane] * A[2, 0, lane]
-            r1 = q[0, i, lane] * A[0, 1, lane] + q[1, i, lane] * A[1, 1, lane] + q[2, i, lane] * A[2, 1, lane]
-            r2 = q[0, i, lane] * A[0, 2, lane] + q[1, i, lane] * A[1, 2, lane] + q[2, i, lane] * A[2, 2, lane]
-            for j in range(3):
-                out[i, j, lane] = r0 * q[0, j, lane] + r1 * q[1, j, lane] + r2 * q[2, j, lane]
 
 
 @njit(cache=True, error_model="numpy", inline="always")

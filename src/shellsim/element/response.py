@@ -14,10 +14,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from ..materials import hyperelastic
 from .assumed_strain import membrane_tying_stresses, project_volumetric, shear_tying_stresses, tie_membrane, tie_shear
+from ..tensor3 import product
 from .kinematics import (add_forces, almansi, field_gradient, global_stress, gradient_vectors, lamina_strain,
-                         point_geometry, product, symmetric_part)
+                         point_geometry, symmetric_part)
 from .lanes import LANES
 from .stress_update import INCREMENTAL, LINEAR, TOTAL, constant_tensor, convected_layer, hyperelastic_layers
 
@@ -40,9 +40,10 @@ class GroupScratch(NamedTuple):
     At the Gauss points (nq, nt, ...): SW (3, G) volume-weighted in-plane stresses, FP, LP
     (3, 3, G) deformation and field gradients, EPS0 (5, G) strains before the tying;
     Bab (nq, 3, G).
-    One lane (the per-lane laws): q1, F1, L1 (3, 3), g1 (2, 3), e1, e01, s1, v5 (5,),
-    Ct (5, 5), Emean (3, 3), M3 (8, 3, 3); Mb (nb, nb), rhs (nb,) of the projection;
-    share (nt,) the layers' weights over their sum.
+    The stress update (:mod:`shellsim.element.stress_update`): axes0 (nq, nt, 3, 3, G)
+    initial material frames (Technique 1), M (11, 3, 3, G), Emean (3, 3, G), pressure,
+    volume, normal (G,). Mb (nb, nb), rhs (nb,) of the projection; share (nt,) the
+    layers' weights over their sum.
     """
 
     members: np.ndarray
@@ -87,17 +88,12 @@ class GroupScratch(NamedTuple):
     LP: np.ndarray
     EPS0: np.ndarray
     Bab: np.ndarray
-    q1: np.ndarray
-    F1: np.ndarray
-    L1: np.ndarray
-    g1: np.ndarray
-    e1: np.ndarray
-    e01: np.ndarray
-    s1: np.ndarray
-    v5: np.ndarray
-    Ct: np.ndarray
+    axes0: np.ndarray
+    M: np.ndarray
     Emean: np.ndarray
-    M3: np.ndarray
+    pressure: np.ndarray
+    volume: np.ndarray
+    normal: np.ndarray
     Mb: np.ndarray
     rhs: np.ndarray
     share: np.ndarray
@@ -120,16 +116,15 @@ def group_scratch(npts, nt, nq, nb):
         cov_shear=np.empty((npts, nt, 2, g)), TS=np.empty((npts, nt, 2, g)), cbar=np.empty((npts, 3, g)),
         T=np.empty((npts, 3, g)), SW=np.empty((nq, nt, 3, g)), FP=np.empty((nq, nt, 3, 3, g)),
         LP=np.empty((nq, nt, 3, 3, g)), EPS0=np.empty((nq, nt, 5, g)), Bab=np.empty((nq, 3, g)),
-        q1=np.empty((3, 3)), F1=np.empty((3, 3)), L1=np.empty((3, 3)), g1=np.empty((2, 3)), e1=np.empty(5),
-        e01=np.empty(5), s1=np.empty(5), v5=np.empty(5), Ct=np.empty((5, 5)), Emean=np.empty((3, 3)),
-        M3=np.empty((8, 3, 3)), Mb=np.empty((nb, nb)), rhs=np.empty(nb), share=np.empty(nt))
+        axes0=np.empty((nq, nt, 3, 3, g)), M=np.empty((11, 3, 3, g)), Emean=np.empty((3, 3, g)), pressure=np.empty(g),
+        volume=np.empty(g), normal=np.empty(g), Mb=np.empty((nb, nb)), rhs=np.empty(nb), share=np.empty(nt))
 
 
 @njit(cache=True, error_model="numpy")
 def group_response(mode, rule, material, work, count):
     """Stresses work.stress and nodal forces work.fe, work.ge (9, 3, G) of the group gathered in
-    ``work``, whose first ``count`` lanes hold elements of their own (the per-lane laws
-    skip the others), with assumed membrane and shear strains (:mod:`shellsim.element.assumed_strain`).
+    ``work``, whose first ``count`` lanes hold elements of their own, with assumed
+    membrane and shear strains (:mod:`shellsim.element.assumed_strain`).
 
     mode (:mod:`shellsim.element.stress_update`): TOTAL, stress from the total Almansi
     strain; INCREMENTAL, work.stress plus C~ times the strain increment of the field
@@ -139,7 +134,7 @@ def group_response(mode, rule, material, work, count):
 
     Constitutive law (``material``, :class:`shellsim.bundles.Material`): the law LINEAR
     uses the reduced matrix C (5, 5); a hyperelastic law (Technique 1, TOTAL and LINEAR
-    modes) its parameters and the members' initial material frames. Techniques 2 and 3
+    modes) its parameters and the members' initial material frames (work.axes0). Techniques 2 and 3
     (law LINEAR, INCREMENTAL) add C times the step's strain increment to the stresses
     kept in the lamina frame, turn them with the material's spin relative to that frame,
     and (2) push them forward with the step's stretch. work.stretch (nq, G): the normal
@@ -148,7 +143,7 @@ def group_response(mode, rule, material, work, count):
     and 3); else left alone. ``rule``: :class:`shellsim.bundles.Rule`.
     """
     N, dNr, dNs, wq, tz, wt = rule.N, rule.dNr, rule.dNs, rule.wq, rule.tz, rule.wt
-    hyper = material.law != hyperelastic.LINEAR
+    hyper = material.technique == 1
     # Techniques 2 and 3: stresses accumulated from strain increments, turned and stretched
     convected = mode == INCREMENTAL and material.technique >= 2
     # the field's (or the step's) gradient serves the initial-stress stiffness (LINEAR) and
@@ -196,18 +191,14 @@ def group_response(mode, rule, material, work, count):
     # 3. stresses at the Gauss points
     for p in range(nq):
         if hyper:
-            for lane in range(count):
-                normal = hyperelastic_layers(mode, material, material.axes0[work.members[lane]], work, stress, p, lane,
-                                             share)
-                if mode == TOTAL:
-                    stretch[p, lane] = normal
+            hyperelastic_layers(mode, material, work, stress, p, share)
         else:
             if convected:
                 stretch[p, :] = 1.0
             for k in range(nt):
                 constant_tensor(material.C, EPS[p, k], stress[p, k], mode == INCREMENTAL)
                 if convected:
-                    convected_layer(material, work, stress, p, k, share[k], stretch, count)
+                    convected_layer(material, work, stress, p, k, share[k], stretch)
         for k in range(nt):
             for i in range(3):
                 for lane in range(LANES):

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..tensor3 import congruence
+from ..tensor3 import product, to_global
 from .kinematics import global_stress, point_geometry
-from .lanes import LANES, gather_shape, group_count, lane_copy
+from .lanes import LANES, gather_element_values, gather_shape, group_count, lane_copy
 
 
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,
@@ -47,13 +47,15 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     """
     members = np.empty(LANES, dtype=np.int64)
     xe, de, he = np.empty((9, 3, LANES)), np.empty((9, 3, LANES)), np.empty((9, LANES))
+    jac0 = np.empty(jac0_inv.shape[1:] + (LANES,))
     jac, jinv, q, det = np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty(LANES)
-    s5, sg, same = np.empty((5, LANES)), np.empty((3, 3, LANES)), np.zeros((3, 3, LANES))
+    s5, sg, F, FtF = np.empty((5, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES)), np.empty((3, 3, LANES))
+    same = np.zeros((3, 3, LANES))
     for i in range(3):
-        same[i, i, :] = 1.0  # the lamina frame is its own
-    jac1, F, eye = np.empty((3, 3)), np.empty((3, 3)), np.eye(3)
+        same[i, i, :] = 1.0  # the lamina frame is its own; also the identity
     for group in range(group_count(conn.shape[0])):
         count = gather_shape(group, conn, x, d, h, members, xe, de, he)
+        gather_element_values(jac0_inv, members, jac0)
         for p in range(N.shape[0]):
             for k in range(tz.shape[0]):
                 point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, det)
@@ -65,12 +67,10 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
                     lane_copy(sg, lane, lamina[members[lane], p, k])
                 global_stress(s5, q, sg)
                 for lane in range(count):
-                    e = members[lane]
-                    lane_copy(sg, lane, cauchy[e, p, k])
-                    lane_copy(jac, lane, jac1)
-                    congruence(jac1, jac0_inv[e, p, k], eye, F)
-                    strain = green[e, p, k]
-                    congruence(F.T, eye, F.T, strain)
-                    for i in range(3):
-                        for j in range(3):
-                            strain[i, j] = 0.5 * (strain[i, j] - eye[i, j])
+                    lane_copy(sg, lane, cauchy[members[lane], p, k])
+                product(jac, jac0[p, k], F)
+                to_global(F, same, FtF)  # F^T F
+                for i in range(3):
+                    for j in range(3):
+                        for lane in range(count):
+                            green[members[lane], p, k, i, j] = 0.5 * (FtF[i, j, lane] - same[i, j, lane])

@@ -88,8 +88,8 @@ class Simulation:
         conn = m.conn[elements]
         N, dNr, dNs = rule.N[:nq][points], rule.dNr[:nq][points], rule.dNs[:nq][points]
         out = [np.empty((len(conn), len(N), len(rule.tz), 3, 3)) for _ in range(3)]
-        point_tensors(s.x, s.d, s.h, conn, N, dNr, dNs, rule.tz, m.body.jac0_inv[elements][:, :nq][:, points],
-                      s.stress[elements][:, points], *out)
+        jac0_inv = np.ascontiguousarray(m.body.jac0_inv[elements][:, :nq][:, points])
+        point_tensors(s.x, s.d, s.h, conn, N, dNr, dNs, rule.tz, jac0_inv, s.stress[elements][:, points], *out)
         return tuple(out)
 
     def critical_time_step(self) -> float:

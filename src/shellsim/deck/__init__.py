@@ -1,71 +1,18 @@
 """Reading decks: TOML in, a validated :class:`Deck` out, or a :class:`DeckError` that names
-every problem (file, key path, value given, what was expected)."""
+every problem (file, key path, value given, what was expected); see :mod:`.reading`.
+
+The names below load on first use: the material laws define their deck tables with this
+package's value types (:mod:`.types`), and the schema in turn lists the laws, so
+importing the package must not import the schema."""
 
 from __future__ import annotations
 
-import tomllib
-from pathlib import Path
+from importlib import import_module
 
-from pydantic import ValidationError
-
-from ..errors import DeckError, ShellsimError
-from .messages import format_errors
-from .references import check_references
-from .schema import Deck
-
-__all__ = ["Deck", "deck_from_data", "load_deck", "parse_deck"]
+__all__ = ["Deck", "deck_from_data", "load_deck", "parse_deck", "resolve_mesh_path"]
 
 
-def load_deck(path: str | Path) -> Deck:
-    """Read and validate the deck at ``path``; mesh files it names are resolved next to it."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise DeckError(str(path), ["file not found"]) from None
-    except IsADirectoryError:
-        raise DeckError(str(path), ["is a directory, expected a .toml deck file"]) from None
-    except UnicodeDecodeError as err:
-        raise DeckError(str(path), [f"not UTF-8 text ({err.reason} at byte {err.start})"]) from None
-    except OSError as err:
-        raise DeckError(str(path), [f"cannot be read: {err.strerror}"]) from None
-    return parse_deck(text, name=str(path), base_dir=path.parent)
-
-
-def parse_deck(text: str, name: str = "<deck>", base_dir: Path | None = None) -> Deck:
-    """Validate deck source ``text``; ``name`` labels messages, ``base_dir`` resolves files."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise DeckError(name, [f"not valid TOML: {err}"]) from None
-    return deck_from_data(data, name, base_dir, text)
-
-
-def deck_from_data(data: dict, name: str = "<deck>", base_dir: Path | None = None, text: str = "") -> Deck:
-    """Validate parsed deck ``data``; ``text`` (its TOML source) gives line numbers."""
-    try:
-        deck = Deck.model_validate(data)
-    except ValidationError as err:
-        raise DeckError(name, format_errors(err, data, text, Deck)) from None
-    problems = check_references(deck, _geometry_sets(deck, name, base_dir))
-    if problems:
-        raise DeckError(name, problems)
-    return deck
-
-
-def _geometry_sets(deck: Deck, name: str, base_dir: Path | None) -> dict[str, str]:
-    if deck.geometry.builder != "file":
-        return deck.geometry.sets()
-    from ..geometry.importing import read_set_kinds
-
-    path = resolve_mesh_path(deck, base_dir)
-    try:
-        return read_set_kinds(path)
-    except ShellsimError as err:
-        raise DeckError(name, [f"geometry.path: {err}"]) from None
-
-
-def resolve_mesh_path(deck: Deck, base_dir: Path | None) -> Path:
-    """The mesh file of a ``builder = 'file'`` deck, relative to the deck's folder."""
-    path = Path(deck.geometry.path)
-    return path if path.is_absolute() or base_dir is None else base_dir / path
+def __getattr__(name: str):
+    if name in __all__:
+        return getattr(import_module(".reading", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

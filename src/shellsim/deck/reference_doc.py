@@ -12,7 +12,8 @@ from pydantic_core import PydanticUndefined
 from . import schema
 from .curves import Curve
 from .geometry import BUILDERS
-from .material import MATERIALS, CylindricalAxes, FixedAxes
+from .axes import CylindricalAxes, FixedAxes
+from .material import MATERIALS
 from .types import tag_of
 
 INTRO = """# Deck reference

@@ -4,7 +4,8 @@ compiled functions called by a law's code (its place in :data:`LAWS`).
 A law is one module of this package with
 - ``INCOMPRESSIBLE``: J = 1 (zero normal stress by the determinant condition), or a
   compressible law whose S_33 is linear in E_33;
-- ``MODELS``: the deck's ``material.model`` names it serves;
+- ``MODELS``: the deck's material models it serves (pydantic tables, ``model`` their
+  tag; the deck accepts exactly the models of the registered laws);
 - ``parameters(material)``: its parameter array (P,) from the deck's ``[material]``;
 - compiled lane functions ``energy(params, E, W)``, ``energy_stress(params, E, S)``
   (S^w = dW/dE) and ``energy_tangent(params, E, dE, dS)`` (dS^w = CC^w : dE), with E, S,
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 from numba import njit
 
+from ..deck.types import tag_of
 from . import guccione, mooney_rivlin, st_venant_kirchhoff
 
 #: The laws, in the order of their codes.
@@ -26,7 +28,7 @@ LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff)
 def law_of(model: str):
     """(code, module) of the law serving the deck's ``material.model``."""
     for code, law in enumerate(LAWS):
-        if model in law.MODELS:
+        if any(tag_of(cls)[1] == model for cls in law.MODELS):
             return code, law
     raise KeyError(f"no hyperelastic law serves material.model = {model!r}")
 

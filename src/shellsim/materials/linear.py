@@ -1,18 +1,46 @@
 """Isotropic linear elasticity reduced for the shell lamina (thesis 3.9, 3.9.1).
 
-Strains and stresses use the five lamina components (11, 22, 12, 13, 23), shears as
-engineering strains: the normal component 33 is removed by static condensation
-(sigma_33 = 0, thesis Eq 3.23) or, in plane strain through the thickness, by eps_33 = 0.
+The deck's ``model = "linear_elastic"`` (small strain; St. Venant-Kirchhoff under
+Technique 1, :mod:`shellsim.materials.st_venant_kirchhoff`). Strains and stresses use
+the five lamina components (11, 22, 12, 13, 23), shears as engineering strains: the
+normal component 33 is removed by static condensation (sigma_33 = 0, thesis Eq 3.23) or,
+in plane strain through the thickness, by eps_33 = 0.
 """
 
 from __future__ import annotations
 
+from typing import ClassVar, Literal
+
 import numpy as np
+from pydantic import field_validator
+
+from ..deck.types import Positive, Real, Section
 
 #: Transverse shear correction factor on the 13 and 23 shear moduli (Reissner-Mindlin,
 #: the value Hughes-Liu shells and LS-DYNA's SHRF default use). The thesis does not state
 #: one; the Mindlin plate reference of Test 1 assumes 5/6.
 SHEAR_FACTOR = 5.0 / 6.0
+
+
+class LinearElastic(Section):
+    """Isotropic linear elastic (small strain; St. Venant-Kirchhoff under Technique 1)."""
+
+    model: Literal["linear_elastic"]
+    E: Positive
+    nu: Real
+    density: Positive
+    HYPERELASTIC: ClassVar[bool] = False
+    ANISOTROPIC: ClassVar[bool] = False
+
+    @field_validator("nu")
+    @classmethod
+    def _compressible(cls, nu: float) -> float:
+        if not -1.0 < nu < 0.5:
+            raise ValueError(
+                f"a compressible model needs -1 < nu < 0.5, got {nu}; for incompressible "
+                "tissue use model = 'neo_hookean', 'mooney_rivlin' or 'guccione'"
+            )
+        return nu
 
 
 def hooke_3d(E: float, nu: float) -> np.ndarray:

@@ -17,14 +17,41 @@ of an element group (:mod:`shellsim.element.lanes`).
 
 from __future__ import annotations
 
+from typing import Annotated, ClassVar, Literal
+
 import numpy as np
 from numba import njit
+from pydantic import Field
 
+from ..deck.types import Positive, Section
 from ..element.lanes import LANES
 
+
+
+class NeoHookean(Section):
+    """Incompressible neo-Hookean: W = C1 (I1 - 3)."""
+
+    model: Literal["neo_hookean"]
+    C1: Positive
+    density: Positive
+    HYPERELASTIC: ClassVar[bool] = True
+    ANISOTROPIC: ClassVar[bool] = False
+
+
+class MooneyRivlin(Section):
+    """Incompressible Mooney-Rivlin: W = C1 (I1 - 3) + C2 (I2 - 3), C1 > 0, C2 >= 0."""
+
+    model: Literal["mooney_rivlin"]
+    C1: Positive
+    C2: Annotated[float, Field(strict=True, ge=0)]
+    density: Positive
+    HYPERELASTIC: ClassVar[bool] = True
+    ANISOTROPIC: ClassVar[bool] = False
+
+
 INCOMPRESSIBLE = True
-#: Deck models (``material.model``) this law serves.
-MODELS = ("neo_hookean", "mooney_rivlin")
+#: The deck's material models this law serves.
+MODELS = (NeoHookean, MooneyRivlin)
 
 
 def parameters(material) -> np.ndarray:

@@ -18,11 +18,11 @@ import numpy as np
 from numba import njit
 
 from ..element.lanes import LANES
-from .linear import SHEAR_FACTOR
+from .linear import SHEAR_FACTOR, LinearElastic
 
 INCOMPRESSIBLE = False
-#: Deck models (``material.model``) this law serves.
-MODELS = ("linear_elastic",)
+#: The deck's material models this law serves (under Technique 1).
+MODELS = (LinearElastic,)
 
 
 def parameters(material) -> np.ndarray:

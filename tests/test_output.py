@@ -305,8 +305,11 @@ def _wait_for_frames(path: Path, count: int, process: subprocess.Popen, limit: f
 
 def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path):
     deck = tmp_path / "long.toml"
+    # a dead load: under the follower pressure this cantilever flutters and folds by t = 9,
+    # which a loaded machine can reach before the signal lands
     deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 500.0")
-                    .replace("times = [0.1, 0.25]", "interval = 0.5"))
+                    .replace("times = [0.1, 0.25]", "interval = 0.5")
+                    .replace('curve = "ramp"', 'curve = "ramp"\nfollower = false'))
     out = tmp_path / "out"
     process = subprocess.Popen([sys.executable, "-m", "shellsim", "run", str(deck), "--out", str(out), "--quiet"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -322,6 +325,20 @@ def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_pa
     assert len(times) == summary["frames"] >= 3
     assert times == pytest.approx(0.5 * np.arange(len(times)))
     assert len(list((out / "frames").glob("*.vtu"))) == len(times)
+
+
+def test_a_run_whose_elements_fold_ends_with_a_message_not_a_traceback(tmp_path):
+    """The cantilever plate under a follower pressure flutters, its amplitude grows and an
+    element folds over near t = 9: the masses on the folded shape are not positive, and
+    the next critical-step estimate would fail inside ARPACK."""
+    deck = tmp_path / "flutter.toml"
+    deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 12.0").replace("times = [0.1, 0.25]", "interval = 3.0"))
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 3, result.output
+    assert "folded over" in result.output and "Traceback" not in result.output
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "unstable"
+    assert meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf").num_steps == summary["frames"] >= 3
 
 
 def test_an_unstable_run_keeps_its_frames_and_says_why(tmp_path):

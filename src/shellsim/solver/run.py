@@ -218,7 +218,9 @@ def _frame(run: Run, listener: Listener) -> None:
 
 def _update_time_step(run: Run, listener: Listener) -> None:
     solver = run.deck.solver
+    _check_stability(run)  # a broken state has no critical step (ARPACK fails on it)
     run.sim.update_masses()
+    _check_masses(run)
     run.dt_critical = run.sim.critical_time_step()
     run.dt = run.dt_critical / solver.dt_safety_factor
     if solver.dt_max is not None:
@@ -238,6 +240,18 @@ def _check_stability(run: Run) -> None:
         raise NumericalError(
             f"the run became unstable at t = {s.t:.6g} after {s.steps} steps: energy is being "
             f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()})"
+            f"{_time_step_hint(run)}")
+
+
+def _check_masses(run: Run) -> None:
+    """The lumped masses, taken on the current shape, are positive: an element folded
+    over has a negative volume, and the critical step of such masses is no number."""
+    s = run.sim.state
+    bad = np.flatnonzero(~(s.mt > 0.0) | ~(s.mr > 0.0))
+    if bad.size:
+        raise NumericalError(
+            f"the run broke down at t = {s.t:.6g} after {s.steps} steps: the lumped masses of {bad.size} "
+            f"nodes (first: {bad[:5].tolist()}) are not positive, so an element around them has folded over"
             f"{_time_step_hint(run)}")
 
 

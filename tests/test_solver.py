@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 import pytest
+from scipy.sparse.linalg import eigsh
 from typer.testing import CliRunner
 
 from shellsim.cli import app
@@ -66,6 +67,24 @@ def test_m1_rotary_inertia_keeps_the_step_of_a_thin_shell():
     m1 = critical_step(0.01, "M1") / critical_step(0.001, "M1")
     assert m2 == pytest.approx(10.0, rel=0.05)
     assert m1 == pytest.approx(1.0, abs=1e-3)
+
+
+def test_a_critical_step_estimate_over_budget_errs_on_the_safe_side(monkeypatch):
+    """The first Lanczos run has PRODUCTS stiffness products; past them the coarse
+    tolerance takes over and its bound is no smaller than the converged one (a shorter
+    step, never a longer one). A 6 x 6 bench plate with a budget of 10 forces the fallback."""
+    from shellsim.solver import timestep
+
+    deck = parse_deck((ROOT / "decks" / "bench" / "plate_step.toml").read_text()
+                      .replace("length = 2, width = 2", "length = 6, width = 6"))
+    sim = prepared(deck).sim
+    converged, _ = timestep.largest_eigenvalue(sim)
+    products = []
+    monkeypatch.setattr(timestep, "PRODUCTS", 10)
+    monkeypatch.setattr(timestep, "eigsh", lambda *a, **k: products.append(k["tol"]) or eigsh(*a, **k))
+    bounded, _ = timestep.largest_eigenvalue(sim)
+    assert products == [timestep.TOLERANCE, timestep.COARSE_TOLERANCE]
+    assert converged * (1 - timestep.TOLERANCE) <= bounded <= converged * (1 + 10 * timestep.COARSE_TOLERANCE)
 
 
 def test_a_step_above_the_critical_one_is_stopped_with_a_clear_message():

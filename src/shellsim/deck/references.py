@@ -10,17 +10,6 @@ import difflib
 
 from .schema import Deck
 
-#: Which set kinds each load type acts on.
-LOAD_SET_KINDS = {
-    "pressure": ("surface",),
-    "body_force": ("surface",),
-    "edge_force": ("edge",),
-    "edge_pressure": ("edge",),
-    "edge_moment": ("edge",),
-    "point_force": ("point", "edge", "surface"),
-    "point_moment": ("point", "edge", "surface"),
-}
-
 
 def did_you_mean(word: str, choices: list[str] | tuple[str, ...]) -> str:
     """'; did you mean 'x'?' when a choice is close to ``word``, else ''."""
@@ -73,7 +62,7 @@ def check_references(deck: Deck, geometry_sets: dict[str, str]) -> list[str]:
         need_set(f"boundary[{i}].set", bc.set)
         need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))
     for i, load in enumerate(deck.load):
-        need_set(f"load[{i}].set", load.set, LOAD_SET_KINDS[load.type])
+        need_set(f"load[{i}].set", load.set, load.SET_KINDS)
         need_curve(f"load[{i}].curve", load.curve)
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)

@@ -7,7 +7,7 @@ deck (defaults filled) is what the program runs.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
@@ -149,6 +149,8 @@ class Pressure(Section):
     curve: Name | None = None
     face: Literal["bottom", "mid", "top"] = "mid"
     follower: bool = True
+    #: The kinds of set the load acts on (:mod:`shellsim.deck.references` checks them).
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
 
 
 class VectorLoad(Section):
@@ -163,6 +165,7 @@ class EdgeForce(VectorLoad):
     """Force per unit (initial) length along an edge set, global components."""
 
     type: Literal["edge_force"]
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
 
 
 class EdgePressure(Section):
@@ -174,24 +177,28 @@ class EdgePressure(Section):
     set: Name
     value: Real
     curve: Name | None = None
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
 
 
 class EdgeMoment(VectorLoad):
     """Moment per unit (initial) length along an edge set, global components."""
 
     type: Literal["edge_moment"]
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
 
 
 class PointForce(VectorLoad):
     """Force on every node of a set, global components."""
 
     type: Literal["point_force"]
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
 
 
 class PointMoment(VectorLoad):
     """Moment on every node of a set, global components."""
 
     type: Literal["point_moment"]
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
 
 
 class BodyForce(VectorLoad):
@@ -200,6 +207,7 @@ class BodyForce(VectorLoad):
 
     type: Literal["body_force"]
     set: Name = "all"
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
 
 
 Load = Annotated[
@@ -427,3 +435,10 @@ class Deck(Section):
         if self.section.thickness_update is not None:
             return self.section.thickness_update
         return self.section.technique is not None
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")

@@ -22,7 +22,8 @@ class Rule(NamedTuple):
     N, dNr, dNs (npts, 9): shape functions and their derivatives at the points; tie
     (3, nq, 6), tie_points (3, 6): the tying interpolation of the covariant membrane
     strains rr, ss, rs; wq (nq,): in-plane weights; tz, wt (nt,): thickness points and
-    weights; vol_basis (nq, nb): fields the in-plane volumetric strain is projected on
+    weights; share (nt,): wt over its sum, each layer's share of a through-thickness
+    mean; vol_basis (nq, nb): fields the in-plane volumetric strain is projected on
     (plane strain: 1, r, s; otherwise nb = 0).
     """
 
@@ -34,6 +35,7 @@ class Rule(NamedTuple):
     wq: np.ndarray
     tz: np.ndarray
     wt: np.ndarray
+    share: np.ndarray
     vol_basis: np.ndarray
 
 

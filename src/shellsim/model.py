@@ -65,7 +65,8 @@ def integration_rule(points_through_thickness: int, plane_strain: bool = False) 
     tz, wt = gauss_rule(points_through_thickness)
     N = shape(points)
     return Rule(N=N, dNr=np.ascontiguousarray(dN[:, :, 0]), dNs=np.ascontiguousarray(dN[:, :, 1]), tie=tie,
-                tie_points=tie_points, wq=wq, tz=tz, wt=wt, vol_basis=volumetric_basis(plane_strain, N[:len(wq)]))
+                tie_points=tie_points, wq=wq, tz=tz, wt=wt, share=wt / wt.sum(),
+                vol_basis=volumetric_basis(plane_strain, N[:len(wq)]))
 
 
 def _lagrange(x: np.ndarray, node: float, nodes: np.ndarray) -> np.ndarray:

@@ -33,27 +33,21 @@ def product(A, B, out):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def product_transposed(A, B, out):
-    """out = A B^T, all (3, 3, G)."""
+def congruence(a, m, b, out):
+    """out = a m b^T, all (3, 3, G)."""
     for i in range(3):
-        for j in range(3):
-            for lane in range(LANES):
-                out[i, j, lane] = 0.0
-            for m in range(3):
-                for lane in range(LANES):
-                    out[i, j, lane] += A[i, m, lane] * B[j, m, lane]
+        for lane in range(LANES):
+            r0 = a[i, 0, lane] * m[0, 0, lane] + a[i, 1, lane] * m[1, 0, lane] + a[i, 2, lane] * m[2, 0, lane]
+            r1 = a[i, 0, lane] * m[0, 1, lane] + a[i, 1, lane] * m[1, 1, lane] + a[i, 2, lane] * m[2, 1, lane]
+            r2 = a[i, 0, lane] * m[0, 2, lane] + a[i, 1, lane] * m[1, 2, lane] + a[i, 2, lane] * m[2, 2, lane]
+            for j in range(3):
+                out[i, j, lane] = r0 * b[j, 0, lane] + r1 * b[j, 1, lane] + r2 * b[j, 2, lane]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def to_lamina(q, A, out):
     """out = q A q^T, all (3, 3, G): a global tensor's lamina components."""
-    for i in range(3):
-        for lane in range(LANES):
-            r0 = q[i, 0, lane] * A[0, 0, lane] + q[i, 1, lane] * A[1, 0, lane] + q[i, 2, lane] * A[2, 0, lane]
-            r1 = q[i, 0, lane] * A[0, 1, lane] + q[i, 1, lane] * A[1, 1, lane] + q[i, 2, lane] * A[2, 1, lane]
-            r2 = q[i, 0, lane] * A[0, 2, lane] + q[i, 1, lane] * A[1, 2, lane] + q[i, 2, lane] * A[2, 2, lane]
-            for j in range(3):
-                out[i, j, lane] = r0 * q[j, 0, lane] + r1 * q[j, 1, lane] + r2 * q[j, 2, lane]
+    congruence(q, A, q, out)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -59,8 +59,8 @@ def _solve2(a00, a01, a10, a11, b0, b1, out0, out1):
 @njit(cache=True, error_model="numpy")
 def tie_membrane(rule, work, nq, nt):
     """Replace the membrane part of the lamina strains work.EPS at the Gauss points by
-    its tied interpolation (the through-thickness means weighted by work.share)."""
-    tie, tie_points, share = rule.tie, rule.tie_points, work.share
+    its tied interpolation (the through-thickness means weighted by rule.share)."""
+    tie, tie_points, share = rule.tie, rule.tie_points, rule.share
     EPS, Q, G, cbar, plane, glob, local, delta = work.EPS, work.Q, work.G, work.cbar, work.plane, work.glob, work.local, work.delta
     # covariant membrane strains c_ab = g_a . eps . g_b (frame-free) and their
     # through-thickness means cbar at every point

@@ -58,10 +58,7 @@ def update_fibre_frame(d: np.ndarray, e1: np.ndarray) -> None:
     """
     e2x, e2y, e2z = cross(d, e1)
     n = np.sqrt(e2x * e2x + e2y * e2y + e2z * e2z)
-    e2x, e2y, e2z = e2x / n, e2y / n, e2z / n
-    e1[0] = e2y * d[2] - e2z * d[1]
-    e1[1] = e2z * d[0] - e2x * d[2]
-    e1[2] = e2x * d[1] - e2y * d[0]
+    e1[0], e1[1], e1[2] = cross((e2x / n, e2y / n, e2z / n), d)
 
 
 @njit(cache=True, error_model="numpy")

@@ -42,8 +42,7 @@ class GroupScratch(NamedTuple):
     Bab (nq, 3, G).
     The stress update (:mod:`shellsim.element.stress_update`): axes0 (nq, nt, 3, 3, G)
     initial material frames (Technique 1), M (11, 3, 3, G), Emean (3, 3, G), pressure,
-    volume, normal (G,). Mb (nb, nb), rhs (nb,) of the projection; share (nt,) the
-    layers' weights over their sum.
+    volume, normal (G,). Mb (nb, nb), rhs (nb,) of the projection.
     """
 
     members: np.ndarray
@@ -96,7 +95,6 @@ class GroupScratch(NamedTuple):
     normal: np.ndarray
     Mb: np.ndarray
     rhs: np.ndarray
-    share: np.ndarray
 
 
 @njit(cache=True, error_model="numpy")
@@ -117,7 +115,7 @@ def group_scratch(npts, nt, nq, nb):
         T=np.empty((npts, 3, g)), SW=np.empty((nq, nt, 3, g)), FP=np.empty((nq, nt, 3, 3, g)),
         LP=np.empty((nq, nt, 3, 3, g)), EPS0=np.empty((nq, nt, 5, g)), Bab=np.empty((nq, 3, g)),
         axes0=np.empty((nq, nt, 3, 3, g)), M=np.empty((11, 3, 3, g)), Emean=np.empty((3, 3, g)), pressure=np.empty(g),
-        volume=np.empty(g), normal=np.empty(g), Mb=np.empty((nb, nb)), rhs=np.empty(nb), share=np.empty(nt))
+        volume=np.empty(g), normal=np.empty(g), Mb=np.empty((nb, nb)), rhs=np.empty(nb))
 
 
 @njit(cache=True, error_model="numpy")
@@ -152,12 +150,7 @@ def group_response(mode, rule, material, work, count):
     nq, npts, nt = wq.shape[0], N.shape[0], tz.shape[0]
     stress, stretch, he, jac, F, eg, v, det = work.stress, work.stretch, work.he, work.jac, work.F, work.eg, work.v, work.det
     Q, jinv_all, G, DV, EPS, SW = work.Q, work.jinv_all, work.G, work.DV, work.EPS, work.SW
-    wsum = 0.0
-    for k in range(nt):
-        wsum += wt[k]
-    share = work.share
-    for k in range(nt):
-        share[k] = wt[k] / wsum
+    share = rule.share
     # 1. geometry and strain at every point
     for p in range(npts):
         for k in range(nt):
@@ -211,7 +204,7 @@ def group_response(mode, rule, material, work, count):
     # 5. nodal forces: the direct stresses at the Gauss points, the tied shears and
     # membrane weights at every point
     fe, ge = work.fe, work.ge
-    _point_forces(rule, work, nq, share, fe, ge)
+    _point_forces(rule, work, nq, fe, ge)
     if mode == LINEAR:
         # initial-stress stiffness: the current stress sigma acting through the field's
         # gradient L, f_a += L sigma gN_a dv (and gM_a for the director)
@@ -224,12 +217,12 @@ def group_response(mode, rule, material, work, count):
 
 
 @njit(cache=True, error_model="numpy")
-def _point_forces(rule, work, nq, share, fe, ge):
+def _point_forces(rule, work, nq, fe, ge):
     """fe, ge (9, 3, G) = the virtual work of the stresses at every point: the direct
     in-plane stresses work.SW at the Gauss points, the tied shears work.TS and the
-    membrane tying weights work.T ((w_k / W) sum_ab T_ab sym(g_a (x) g_b), share (nt,)
-    = w_k / W)."""
-    N, dNr, dNs, tz = rule.N, rule.dNr, rule.dNs, rule.tz
+    membrane tying weights work.T ((w_k / W) sum_ab T_ab sym(g_a (x) g_b), w_k / W =
+    rule.share[k])."""
+    N, dNr, dNs, tz, share = rule.N, rule.dNr, rule.dNs, rule.tz, rule.share
     SW, TS, T, A, G, s5, sg = work.SW, work.TS, work.T, work.A, work.G, work.s5, work.sg
     fe[:] = 0.0
     ge[:] = 0.0

@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from ..materials import zero_normal_stress
-from ..tensor3 import det3, product, product_transposed, to_global, to_lamina
+from ..tensor3 import congruence, det3, to_global, to_lamina
 from .lanes import LANES
 
 #: Modes of :func:`shellsim.element.response.group_response`: stress from the total
@@ -60,8 +60,7 @@ def hyperelastic_layers(mode, material, work, stress, p, share):
     law_work, det, pressure, volume, Emean = work.M[8:], work.det, work.pressure, work.volume, work.Emean
     Emean[:] = 0.0
     for k in range(share.shape[0]):
-        product(work.Q[p, k], work.FP[p, k], tmp)
-        product_transposed(tmp, work.axes0[p, k], Fl)
+        congruence(work.Q[p, k], work.FP[p, k], work.axes0[p, k], Fl)
         det3(Fl, det)
         # 1/2 (Fl^T Fl - I) + Fl^T (eps - eps0) Fl = Fl^T (eps - eps0 + I/2) Fl - I/2
         D[:] = 0.0

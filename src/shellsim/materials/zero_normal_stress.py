@@ -132,9 +132,12 @@ def tangent(material, E, Cinv, pressure, dE, dS, work):
             unit[2, 2, lane] = 1.0
         energy_tangent(law, params, E, unit, normal)
         energy_tangent(law, params, E, dE, dS)
+        # the tangent is linear in dE: adding dE33 adds dE33 times the unit's response
         for lane in range(LANES):
             dE[2, 2, lane] = -dS[2, 2, lane] / normal[2, 2, lane]
-        energy_tangent(law, params, E, dE, dS)
+            for i in range(3):
+                for j in range(3):
+                    dS[i, j, lane] += dE[2, 2, lane] * normal[i, j, lane]
     for lane in range(LANES):
         dS[2, 2, lane] = 0.0
 

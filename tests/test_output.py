@@ -6,6 +6,7 @@ the files of runs stopped by Ctrl-C or by an instability."""
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -23,7 +24,7 @@ from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import OutputError
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
 from shellsim.output.series import check_space
-from shellsim.solver.run import output_times
+from shellsim.solver.run import Listener, integrate, output_times
 
 from .conftest import ROOT, deck_text, prepared
 
@@ -325,6 +326,29 @@ def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_pa
     assert len(times) == summary["frames"] >= 3
     assert times == pytest.approx(0.5 * np.arange(len(times)))
     assert len(list((out / "frames").glob("*.vtu"))) == len(times)
+
+
+class _InterruptedMidFrame(Listener):
+    """Writes each frame in two parts and has Ctrl-C land between them at the second frame."""
+
+    def __init__(self):
+        self.parts = []
+
+    def on_frame(self, run):
+        self.parts.append("first")
+        if len(self.parts) == 3:
+            os.kill(os.getpid(), signal.SIGINT)
+        self.parts.append("second")
+
+
+def test_ctrl_c_during_a_frame_lands_after_the_whole_frame_is_written_and_counted():
+    run = prepared(parse_deck(PLATE))
+    listener = _InterruptedMidFrame()
+    with pytest.raises(KeyboardInterrupt):
+        integrate(run, listener)
+    assert run.status == "interrupted"
+    assert listener.parts == ["first", "second"] * 2
+    assert len(run.frame_times) == 2
 
 
 def test_a_run_whose_elements_fold_ends_with_a_message_not_a_traceback(tmp_path):

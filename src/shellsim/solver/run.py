@@ -9,7 +9,11 @@ history time, ``listener.on_frame(run)`` at t = 0 and at every output time, and
 from __future__ import annotations
 
 import math
+import signal
+import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -211,9 +215,28 @@ def _record(run: Run, listener: Listener) -> None:
     listener.on_sample(run)
 
 
+@contextmanager
+def interrupt_deferred() -> Iterator[None]:
+    """Hold a Ctrl-C that arrives inside the block until the block is done, then raise it,
+    so a frame is written to every series and counted, or not at all. (Signal handlers can
+    only be set from the main thread; elsewhere the block runs as it is.)"""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = []
+    previous = signal.signal(signal.SIGINT, lambda *_: held.append(True))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if held:
+        raise KeyboardInterrupt
+
+
 def _frame(run: Run, listener: Listener) -> None:
-    listener.on_frame(run)
-    run.frame_times.append(run.sim.state.t)
+    with interrupt_deferred():
+        listener.on_frame(run)
+        run.frame_times.append(run.sim.state.t)
 
 
 def _update_time_step(run: Run, listener: Listener) -> None:

@@ -270,10 +270,21 @@ def test_a_file_without_quad9_is_refused_with_what_it_holds(tmp_path):
 
     meshio.write(tmp_path / "tri.vtu", meshio.Mesh(np.eye(3), [("triangle", np.array([[0, 1, 2]]))]))
     from shellsim.deck import parse_deck
-    from shellsim.errors import DeckError
 
-    with pytest.raises(DeckError, match=r"geometry.path: .*no 9-node quadrilaterals \(quad9\); found triangle"):
-        parse_deck(deck_text('builder = "file"\npath = "tri.vtu"'), base_dir=tmp_path)
+    deck = parse_deck(deck_text('builder = "file"\npath = "tri.vtu"'), base_dir=tmp_path)
+    with pytest.raises(MeshError, match=r"tri.vtu' has no 9-node quadrilaterals \(quad9\); found triangle"):
+        build_mesh(deck, tmp_path)
+
+
+def test_a_set_the_mesh_file_lacks_is_named_with_the_file_and_the_sets_it_has(tmp_path):
+    from shellsim.output.mesh_files import write_mesh_vtu
+
+    _, original = build(BUILDERS["rectangle"][0], BUILDERS["rectangle"][1])
+    write_mesh_vtu(original, tmp_path / "plate.vtu")
+    with pytest.raises(MeshError, match=r"(?s)mesh file '.*plate.vtu' does not have.*"
+                                        r"boundary\[0\].set: unknown set 'x1y11'; did you mean 'x1y1'\?.*y0"):
+        build('builder = "file"\npath = "' + str(tmp_path / "plate.vtu") + '"',
+              extra='[[boundary]]\ntype = "clamped"\nset = "x1y11"\n')
 
 
 def test_mesh_png_is_not_blank(tmp_path):

@@ -9,10 +9,11 @@ from pathlib import Path
 
 from pydantic import ValidationError
 
-from ..errors import DeckError, ShellsimError
+from ..errors import DeckError
 from .messages import format_errors
 from .references import check_references
 from .schema import Deck
+
 
 def load_deck(path: str | Path) -> Deck:
     """Read and validate the deck at ``path``; mesh files it names are resolved next to it."""
@@ -45,22 +46,11 @@ def deck_from_data(data: dict, name: str = "<deck>", base_dir: Path | None = Non
         deck = Deck.model_validate(data)
     except ValidationError as err:
         raise DeckError(name, format_errors(err, data, text, Deck)) from None
-    problems = check_references(deck, _geometry_sets(deck, name, base_dir))
+    builder_sets = deck.geometry.sets() if deck.geometry.builder != "file" else None
+    problems = check_references(deck, builder_sets)
     if problems:
         raise DeckError(name, problems)
     return deck
-
-
-def _geometry_sets(deck: Deck, name: str, base_dir: Path | None) -> dict[str, str]:
-    if deck.geometry.builder != "file":
-        return deck.geometry.sets()
-    from ..geometry.importing import read_set_kinds
-
-    path = resolve_mesh_path(deck, base_dir)
-    try:
-        return read_set_kinds(path)
-    except ShellsimError as err:
-        raise DeckError(name, [f"geometry.path: {err}"]) from None
 
 
 def resolve_mesh_path(deck: Deck, base_dir: Path | None) -> Path:

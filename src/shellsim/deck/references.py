@@ -1,7 +1,8 @@
 """Names that tie the deck's tables together: sets (from the geometry), curves, probes.
 
-Checked after the tables themselves validate, against the set names the geometry will
-produce, so a misspelt name is caught before any meshing or computing.
+Checked after the tables themselves validate, against the set names a builder will
+produce, so a misspelt name is caught before any meshing or computing. A mesh file's sets
+are known once the file is read: :func:`shellsim.geometry.build_mesh` checks them then.
 """
 
 from __future__ import annotations
@@ -23,18 +24,21 @@ def all_sets(deck: Deck, geometry_sets: dict[str, str]) -> dict[str, str]:
     return geometry_sets | {"all": "surface"} | {name: "point" for name in deck.mesh.points}
 
 
-def check_references(deck: Deck, geometry_sets: dict[str, str]) -> list[str]:
+def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[str]:
     """Problems with names in ``deck``, one message per problem (empty when all resolve).
 
     Parameters
     ----------
     deck : a validated deck.
-    geometry_sets : set name -> kind ('surface', 'edge' or 'point') the geometry provides.
+    geometry_sets : set name -> kind ('surface', 'edge' or 'point') the geometry provides;
+        None when they are not known yet (a mesh file not read): sets are then not checked.
     """
-    sets = all_sets(deck, geometry_sets)
+    sets = all_sets(deck, geometry_sets or {})
     problems: list[str] = []
 
     def need_set(path: str, name: str, kinds: tuple[str, ...] = ("surface", "edge", "point")) -> None:
+        if geometry_sets is None:
+            return
         if name not in sets:
             listing = ", ".join(sorted(sets))
             problems.append(
@@ -56,7 +60,7 @@ def check_references(deck: Deck, geometry_sets: dict[str, str]) -> list[str]:
             )
 
     for name in deck.mesh.points:
-        if name in geometry_sets:
+        if name in (geometry_sets or {}):
             problems.append(f"mesh.points.{name}: the geometry already has a set named '{name}'")
     for i, bc in enumerate(deck.boundary):
         need_set(f"boundary[{i}].set", bc.set)

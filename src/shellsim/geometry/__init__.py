@@ -8,6 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..deck import Deck, resolve_mesh_path
+from ..deck.references import check_references
+from ..errors import MeshError
 from ..mesh import (
     Mesh, NamedSet, averaged_directors, check_mesh, combine_surface_normals, orient_consistently,
     snap_points,
@@ -21,7 +23,8 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
 
     Directors are the exact surface normals of the built geometry (averaged where patches
     meet); for a file, its own directors or else the averaged element normals.
-    Raises MeshError when the mesh cannot be built or fails the geometric checks.
+    Raises MeshError when the mesh cannot be built, a file lacks a set the deck names, or the
+    mesh fails the geometric checks.
     """
     g = deck.geometry
     director = thickness = None
@@ -29,8 +32,13 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     if g.builder == "file":
         from .importing import read_mesh
 
-        imported = read_mesh(resolve_mesh_path(deck, base_dir))
+        path = resolve_mesh_path(deck, base_dir)
+        imported = read_mesh(path)
         x, conn, sets = imported.x, imported.conn, imported.sets
+        problems = check_references(deck, {name: s.kind for name, s in sets.items()})
+        if problems:
+            raise MeshError(f"the deck names sets that mesh file '{path}' does not have:\n"
+                            + "\n".join(f"  - {p}" for p in problems))
         director, thickness = imported.director, imported.thickness
         preferred = director[conn[:, 8]] if director is not None else None
     else:

@@ -48,11 +48,6 @@ def _read(path: Path):
         raise MeshError(f"mesh file '{path}' could not be read: {err}") from None
 
 
-def read_set_kinds(path: Path) -> dict[str, str]:
-    """Names and kinds of the named sets in a mesh file, without building the mesh."""
-    return {name: s.kind for name, s in read_mesh(path).sets.items()}
-
-
 def read_mesh(path: Path) -> ImportedMesh:
     """Read a quad9 mesh and its named sets; nodes not used by any quad are dropped."""
     m = _read(Path(path))

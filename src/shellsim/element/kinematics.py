@@ -34,6 +34,14 @@ from .lanes import LANES
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def fibre_point(x, d, h, t):
+    """The point at thickness coordinate t in [-1, 1] on the fibre of a node at x with
+    director d and fibre length h: x + t h/2 d (thesis Eq 3.3 at one node). Scalars or
+    broadcasting arrays, in compiled code or from Python."""
+    return x + t * 0.5 * h * d
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def lamina_frame(jac, q):
     """Hughes' lamina basis from the tangents g_r = jac[:, 0], g_s = jac[:, 1] (3, 3, G).
 

@@ -6,6 +6,7 @@ import numpy as np
 from numba import njit
 
 from ..element.frames import cross
+from ..element.kinematics import fibre_point
 
 
 @njit(cache=True)
@@ -35,7 +36,7 @@ def pressure_forces(rule, conn, shape, faces, scale, f, g):
             for a in range(9):
                 node = conn[e, a]
                 for i in range(3):
-                    pos = x[node, i] + t * 0.5 * h[node] * d[node, i]
+                    pos = fibre_point(x[node, i], d[node, i], h[node], t)
                     yr[i] += dNr[p, a] * pos
                     ys[i] += dNs[p, a] * pos
             area[0], area[1], area[2] = cross(yr, ys)

@@ -19,10 +19,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..deck import Deck
-from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
 from ..errors import NumericalError
 from ..mesh import Mesh
-from ..model import FACES, Model
+from ..model import Model
+from ..output.probes import Probe, probe_value, resolve_probes
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
 from .simulation import Simulation
 
@@ -32,28 +32,6 @@ HISTORY_SAMPLES = 2000
 UNSTABLE_BALANCE = 0.5
 #: Energies below this share of the external work are round-off, not a balance to judge.
 ENERGY_FLOOR = 1e-12
-#: Quantities read at the integration point nearest to the probe's set.
-POINT_QUANTITIES = ("stress", "strain", "pressure_band")
-
-
-#: Tensor components of a probe as (row, column) of the global tensor.
-TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
-
-
-@dataclass
-class Probe:
-    """Where a deck's probe reads: its nodes, quantity and component; for stress, the
-    integration point (element, in-plane point) nearest to the nodes."""
-
-    name: str
-    quantity: str
-    component: str
-    nodes: np.ndarray
-    element: int = -1
-    point: int = -1
-    face: float = 0.0  # thickness coordinate t of a position or displacement: -1, 0, +1
-
-
 @dataclass
 class Run:
     """A scene being run: the simulation, its time step record and probe histories."""
@@ -149,44 +127,9 @@ class Timed(Listener):
         self._timed(self.listener.on_frame, run)
 
 
-def probe_value(run: Run, probe: Probe) -> float:
-    """The probe's current value (the mean over its nodes)."""
-    s, m = run.sim.state, run.model
-    nodes = probe.nodes
-    if probe.quantity in POINT_QUANTITIES:
-        e, p = probe.element, probe.point
-        _, cauchy, green = run.sim.point_tensors(slice(e, e + 1), slice(p, p + 1))
-        tensor = thickness_mean((green if probe.quantity == "strain" else cauchy)[0, 0], m.rule.wt, axis=0)
-        if probe.quantity == "pressure_band":
-            return float(pressure_band(tensor))
-        return float(tensor[TENSOR_COMPONENTS[probe.component]])
-    if probe.quantity == "thickness":
-        return float(s.h[nodes].mean())
-    if probe.quantity == "rotation":
-        return float(np.linalg.norm(s.theta[nodes], axis=1).mean())
-    if probe.quantity == "director":
-        vector = s.d[nodes].mean(axis=0)
-    else:  # a position or displacement on the probe's face
-        half = 0.5 * probe.face
-        position = s.x[nodes] + half * s.h[nodes, None] * s.d[nodes]
-        start = m.x0[nodes] + half * m.h0[nodes, None] * m.d0[nodes]
-        vector = (position if probe.quantity == "position" else position - start).mean(axis=0)
-    if probe.component == "magnitude":
-        return float(np.linalg.norm(vector))
-    return float(vector["xyz".index(probe.component)])
-
-
 def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     """A run ready to start: simulation built, probes resolved."""
-    probes = []
-    for p in deck.output.probe:
-        nodes = mesh.sets[p.set].nodes
-        if p.quantity in POINT_QUANTITIES:
-            element, point = nearest_integration_point(model.x0, model.conn, model.rule.N[:len(model.rule.wq)],
-                                                       model.x0[nodes].mean(axis=0))
-            probes.append(Probe(p.name, p.quantity, p.component, nodes, element, point))
-            continue
-        probes.append(Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face]))
+    probes = resolve_probes(deck.output.probe, mesh, model)
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
     run.history = {p.name: [] for p in probes}
     return run
@@ -210,7 +153,7 @@ def output_times(deck: Deck) -> np.ndarray:
 def _record(run: Run, listener: Listener) -> None:
     run.times.append(run.sim.state.t)
     for p in run.probes:
-        run.history[p.name].append(probe_value(run, p))
+        run.history[p.name].append(probe_value(run.sim, p))
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
 

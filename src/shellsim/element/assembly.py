@@ -192,4 +192,6 @@ def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts)
     """
     vd = np.empty((shape.x.shape[0], 3))
     director_increments(vr, shape.d, shape.e1, vd)
-    _all_elements(LINEAR, rule, body, material, shape, vu, vd, stress, stress, f, fr, parts)
+    # the mode as a run-time integer: passed as the constant, it would type as a literal and
+    # compile the whole element path a second time (half of a cold start's compiling)
+    _all_elements(np.int64(LINEAR), rule, body, material, shape, vu, vd, stress, stress, f, fr, parts)

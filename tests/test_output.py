@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from shellsim.cli import app
+from shellsim.cli import app, sigterm_as_interrupt
 from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import OutputError
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
@@ -304,7 +304,8 @@ def _wait_for_frames(path: Path, count: int, process: subprocess.Popen, limit: f
     raise AssertionError(f"no {count} frames in {path} after {limit} s")
 
 
-def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path):
+@pytest.mark.parametrize(("stop", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
+def test_a_stopped_run_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path, stop, code):
     deck = tmp_path / "long.toml"
     # a dead load: under the follower pressure this cantilever flutters and folds by t = 9,
     # which a loaded machine can reach before the signal lands
@@ -315,11 +316,12 @@ def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_pa
     process = subprocess.Popen([sys.executable, "-m", "shellsim", "run", str(deck), "--out", str(out), "--quiet"],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     _wait_for_frames(out / "results.xdmf", 3, process)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(stop)
     _, stderr = process.communicate(timeout=60)
-    assert process.returncode == 130, stderr
+    assert process.returncode == code, stderr
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "interrupted"
+    assert summary["message"] == ("terminated by SIGTERM" if stop == signal.SIGTERM else "interrupted by the user")
     reader = meshio.xdmf.TimeSeriesReader(out / "results.xdmf")
     reader.read_points_cells()
     times = [reader.read_data(k)[0] for k in range(reader.num_steps)]
@@ -328,41 +330,47 @@ def test_ctrl_c_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_pa
     assert len(list((out / "frames").glob("*.vtu"))) == len(times)
 
 
-class _InterruptedMidFrame(Listener):
-    """Writes each frame in two parts and has Ctrl-C land between them at the second frame."""
+class _StoppedMidFrame(Listener):
+    """Writes each frame in two parts and has the signal ``stop`` land between them at the
+    second frame."""
 
-    def __init__(self):
+    def __init__(self, stop):
+        self.stop = stop
         self.parts = []
 
     def on_frame(self, run):
         self.parts.append("first")
         if len(self.parts) == 3:
-            os.kill(os.getpid(), signal.SIGINT)
+            os.kill(os.getpid(), self.stop)
         self.parts.append("second")
 
 
-def test_ctrl_c_during_a_frame_lands_after_the_whole_frame_is_written_and_counted():
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_a_stop_during_a_frame_lands_after_the_whole_frame_is_written_and_counted(stop):
     run = prepared(parse_deck(PLATE))
-    listener = _InterruptedMidFrame()
-    with pytest.raises(KeyboardInterrupt):
+    listener = _StoppedMidFrame(stop)
+    with pytest.raises(KeyboardInterrupt), sigterm_as_interrupt([]):
         integrate(run, listener)
     assert run.status == "interrupted"
     assert listener.parts == ["first", "second"] * 2
     assert len(run.frame_times) == 2
 
 
-def test_a_run_whose_elements_fold_ends_with_a_message_not_a_traceback(tmp_path):
-    """The cantilever plate under a follower pressure flutters, its amplitude grows and an
-    element folds over near t = 9: the masses on the folded shape are not positive, and
-    the next critical-step estimate would fail inside ARPACK."""
-    deck = tmp_path / "flutter.toml"
-    deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 12.0").replace("times = [0.1, 0.25]", "interval = 3.0"))
-    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+@pytest.mark.parametrize("tolerance", ["tolerance = 1e-3", "tolerance_percent = 5.0"])
+@pytest.mark.parametrize("measure", ['measure = "at_time"\ntime = 0.4', 'measure = "first_peak_time"',
+                                     'measure = "final"'])
+def test_an_unstable_run_prints_its_reference_table_and_why(tmp_path, tolerance, measure):
+    """Every shape of reference entry prints: absolute and relative tolerances, a measure
+    taken and one the broken history cannot give."""
+    deck = tmp_path / "unstable.toml"
+    deck.write_text(PLATE.replace("end_time = 0.5", "end_time = 0.5\ndt_safety_factor = 0.5")
+                    + f'\n[[reference]]\nquantity = "tip"\nprobe = "tip"\n{measure}\n'
+                      f'expected = 0.05\n{tolerance}\nsource = "none; the run breaks down"\n')
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out")])
     assert result.exit_code == 3, result.output
-    assert "folded over" in result.output and "Traceback" not in result.output
-    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    assert summary["status"] == "unstable"
-    assert meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf").num_steps == summary["frames"] >= 3
+    assert "unstable" in result.output and "dt_safety_factor" in result.output
+    assert "tip" in result.output and "0.05" in result.output
+    assert "energies [" in result.output  # the message's brackets are text, not markup
 
 
 def test_an_unstable_run_keeps_its_frames_and_says_why(tmp_path):

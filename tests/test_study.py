@@ -131,10 +131,17 @@ def test_a_stability_run_is_judged_by_its_energy_balance_and_its_falling_step():
     assert row(replace(job, balance_within_percent=None, dt_falls_by=None), SUMMARY)["passed"] is None  # nothing checked
 
 
+def _entry(**values) -> dict:
+    """A summary's reference entry (the keys :func:`shellsim.verify.check.check` gives),
+    expected 1.0 with a 2% tolerance, with ``values`` in place."""
+    return {"quantity": "q", "probe": "p", "measure": "final", "computed": None, "expected": 1.0, "error": None,
+            "error_percent": None, "tolerance_percent": 2.0, "tolerance": None, "passed": False,
+            "source": "a test"} | values
+
+
 def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
     summary = SUMMARY | {"status": "unstable", "message": "the run became unstable",
-                         "reference": [{"expected": 1.0, "error": 0.98, "error_percent": 98.0, "tolerance": None,
-                                        "passed": False}]}
+                         "reference": [_entry(error=0.98, error_percent=98.0, passed=False)]}
     on_purpose = row(Job("f", "v", Path("d.toml"), {}, Path("out"), expect="unstable"), summary)
     assert on_purpose["error_percent"] is None and on_purpose["passed"] is None and as_expected(on_purpose)
     by_accident = row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary)
@@ -144,14 +151,12 @@ def test_a_run_cut_short_is_judged_by_its_expected_status_not_its_references():
 
 
 def test_a_coarse_mesh_expected_to_miss_is_judged_by_missing():
-    summary = SUMMARY | {"reference": [{"expected": 1.0, "error": 0.038, "error_percent": 3.8, "tolerance": None,
-                                        "passed": False}]}
+    summary = SUMMARY | {"reference": [_entry(error=0.038, error_percent=3.8, passed=False)]}
     coarse = Job("f", "1x1", Path("d.toml"), {}, Path("out"), expect="missed")
     missed = row(coarse, summary)
     assert missed["error_percent"] == 3.8 and as_expected(missed)
     assert "as expected" in table([missed]) and "(expected" not in table([missed])
-    met = row(coarse, summary | {"reference": [{"expected": 1.0, "error": 0.01, "error_percent": 1.0, "tolerance": None,
-                                                "passed": True}]})
+    met = row(coarse, summary | {"reference": [_entry(error=0.01, error_percent=1.0, passed=True)]})
     assert not as_expected(met) and "completed (expected missed)" in table([met])  # a change worth a look
     unstable = row(coarse, summary | {"status": "unstable"})
     assert not as_expected(unstable)
@@ -161,10 +166,10 @@ def test_an_absolute_tolerance_counts_its_error_against_the_largest_value_on_its
     """A tip swinging back through zero: 0.1 off an expected 0.4 is 1% of the 10 the
     probe reaches, not 25%."""
     references = [
-        {"probe": "tip", "expected": -10.0, "error": 0.05, "error_percent": -0.5, "tolerance": 0.24, "passed": True},
-        {"probe": "tip", "expected": 0.4, "error": 0.1, "error_percent": 25.0, "tolerance": 0.24, "passed": True},
-        {"probe": "twist", "expected": 0.0, "error": 1e-12, "error_percent": None, "tolerance": 0.01, "passed": True},
-        {"probe": "r", "expected": 2.0, "error": 0.02, "error_percent": 1.0, "tolerance": None, "passed": True},
+        _entry(probe="tip", expected=-10.0, error=0.05, error_percent=-0.5, tolerance=0.24, passed=True),
+        _entry(probe="tip", expected=0.4, error=0.1, error_percent=25.0, tolerance=0.24, passed=True),
+        _entry(probe="twist", expected=0.0, error=1e-12, tolerance=0.01, passed=True),
+        _entry(probe="r", expected=2.0, error=0.02, error_percent=1.0, passed=True),
     ]
     summary = SUMMARY | {"reference": references}
     assert row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary)["error_percent"] == pytest.approx(1.0)

@@ -7,18 +7,21 @@ traceback; the exit code is then 2 (1 is kept for a failed reference check).
 from __future__ import annotations
 
 import functools
+import signal
 import sys
-from contextlib import closing
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import closing, contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from . import __version__
-from .errors import OutputError, ShellsimError
+from .errors import OutputError, ShellsimError, Terminated
 from .output.folder import output_folder
 
 app = typer.Typer(
@@ -32,23 +35,46 @@ err = Console(stderr=True)
 
 EXIT_USER_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_TERMINATED = 143  # 128 + SIGTERM, as shells report it
 
 DeckPath = Annotated[Path, typer.Argument(help="Scene deck (TOML).", show_default=False)]
 
 
+@contextmanager
+def sigterm_as_interrupt(received: list) -> Iterator[None]:
+    """Within the block, SIGTERM raises :class:`Terminated` (a KeyboardInterrupt, so every
+    Ctrl-C path closes files and marks the run) and is noted in ``received``."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(number: int, _frame: Any) -> None:
+        received.append(number)
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def reports_errors(command: Callable[..., Any]) -> Callable[..., Any]:
-    """Turn ShellsimError into a message and exit code 2, Ctrl-C into exit code 130."""
+    """Turn ShellsimError into a message and exit code 2, Ctrl-C into exit code 130 and
+    SIGTERM into 143."""
 
     @functools.wraps(command)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        received: list[int] = []
         try:
-            return command(*args, **kwargs)
+            with sigterm_as_interrupt(received):
+                return command(*args, **kwargs)
         except ShellsimError as error:
-            err.print(f"[bold red]error:[/] {error}", highlight=False, markup=True, soft_wrap=True)
+            err.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, markup=True, soft_wrap=True)
             raise typer.Exit(EXIT_USER_ERROR) from None
         except KeyboardInterrupt:
-            err.print("[yellow]interrupted[/]")
-            raise typer.Exit(EXIT_INTERRUPTED) from None
+            err.print("[yellow]terminated[/]" if received else "[yellow]interrupted[/]")
+            raise typer.Exit(EXIT_TERMINATED if received else EXIT_INTERRUPTED) from None
 
     return wrapper
 
@@ -120,7 +146,7 @@ def mesh(
         render_mesh(built, folder / "mesh.png")
         written.append(folder / "mesh.png")
     sets = ", ".join(f"{name} ({s.kind}, {len(s.nodes)})" for name, s in sorted(built.sets.items()))
-    out.print(f"{scene.meta.title}: {built.n_elements} elements, {built.n_nodes} nodes, "
+    out.print(f"{escape(scene.meta.title)}: {built.n_elements} elements, {built.n_nodes} nodes, "
               f"{5 * built.n_nodes} DOFs")
     out.print(f"sets: {sets}", highlight=False)
     _announce(written)
@@ -146,7 +172,8 @@ def run(
     """Integrate a scene in time (explicit central differences). Writes OUT/summary.json,
     OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
     and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
-    reference check fails, 3 when the run goes unstable."""
+    reference check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM
+    (what was written stays readable; the summary says interrupted)."""
     from .deck import load_deck
     from .execute import run_scene
     from .output.progress import ProgressDisplay
@@ -165,7 +192,7 @@ def run(
     if not quiet:
         out.print(_run_report(result, folder))
     if current.status == "unstable":
-        err.print(f"[bold red]error:[/] {message}", highlight=False)
+        err.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
@@ -182,22 +209,26 @@ def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
 
 
 def _run_report(result: dict, folder: Path) -> Table | str:
+    """The run's references as a table (or a line without them); the deck's texts are shown
+    as written, never read as markup."""
     e = result["energy"]
     caption = (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
                f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
                f"{e['balance_error_percent']:+.3f}%"
                + (f", volume change {result['volume_change_percent']:+.3f}%" if "volume_change_percent" in result else "")
-               + f"; results in {folder}")
+               + f"; results in {escape(str(folder))}")
+    title = f"{escape(result['title'])}: {result['status']}"
     if not result["reference"]:
-        return f"{result['title']}: {result['status']}\n{caption}"
-    table = Table(title=f"{result['title']}: {result['status']}", title_justify="left", caption=caption)
+        return f"{title}\n{caption}"
+    notes = [escape(f"{r['quantity']}: {r['note']}") for r in result["reference"] if "note" in r]
+    table = Table(title=title, title_justify="left", caption="\n".join([*notes, caption]))
     for column in ("quantity", "computed", "expected", "error", "tolerance", "ok"):
         table.add_column(column)
     for r in result["reference"]:
-        tolerance = f"{r['tolerance_percent']}%" if r.get("tolerance") is None else f"{r['tolerance']}"
+        tolerance = f"{r['tolerance_percent']}%" if r["tolerance"] is None else f"{r['tolerance']}"
         error = "-" if r["computed"] is None else (
             f"{r['error_percent']:+.3f}%" if r.get("error_percent") is not None else f"{r['error']:+.4g}")
-        table.add_row(r["quantity"], "-" if r["computed"] is None else f"{r['computed']:.6g}",
+        table.add_row(escape(r["quantity"]), "-" if r["computed"] is None else f"{r['computed']:.6g}",
                       f"{r['expected']:.6g}", error, tolerance, "[green]yes" if r["passed"] else "[red]no")
     return table
 

@@ -40,3 +40,11 @@ class NumericalError(ShellsimError):
 
 class NotYetAvailable(ShellsimError):
     """A command whose work is planned but not built yet."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (what schedulers and ``timeout`` send), handled like Ctrl-C: the run stops,
+    its files are closed and its summary is marked interrupted."""
+
+    def __str__(self) -> str:
+        return "terminated by SIGTERM"

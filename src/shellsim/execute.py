@@ -57,8 +57,8 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
             integrate(current, Listeners(writers, progress or Listener()))
         except NumericalError as error:
             message = str(error)
-        except KeyboardInterrupt:
-            message = "interrupted by the user"
+        except KeyboardInterrupt as stop:
+            message = str(stop) or "interrupted by the user"
         except OutputError as error:
             current.status, message = "output failed", str(error)
         finally:

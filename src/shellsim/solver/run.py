@@ -158,22 +158,28 @@ def _record(run: Run, listener: Listener) -> None:
     listener.on_sample(run)
 
 
+#: Signals that stop a run (Ctrl-C, and SIGTERM where the command line handles it).
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
 @contextmanager
 def interrupt_deferred() -> Iterator[None]:
-    """Hold a Ctrl-C that arrives inside the block until the block is done, then raise it,
-    so a frame is written to every series and counted, or not at all. (Signal handlers can
-    only be set from the main thread; elsewhere the block runs as it is.)"""
+    """Hold a stop signal that arrives inside the block until the block is done, then
+    deliver it to its own handler, so a frame is written to every series and counted, or
+    not at all. (Signal handlers can only be set from the main thread; elsewhere the
+    block runs as it is.)"""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     held = []
-    previous = signal.signal(signal.SIGINT, lambda *_: held.append(True))
+    previous = {number: signal.signal(number, lambda number, _: held.append(number)) for number in STOP_SIGNALS}
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
-    if held:
-        raise KeyboardInterrupt
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+    for number in dict.fromkeys(held):
+        signal.raise_signal(number)
 
 
 def _frame(run: Run, listener: Listener) -> None:

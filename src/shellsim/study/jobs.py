@@ -103,15 +103,15 @@ def _reference_errors(references: list[dict]) -> list[float | None]:
     relative to a value near zero says nothing. None where neither is defined."""
     largest: dict[str, float] = {}
     for r in references:
-        largest[r.get("probe")] = max(largest.get(r.get("probe"), 0.0), abs(r["expected"]))
+        largest[r["probe"]] = max(largest.get(r["probe"], 0.0), abs(r["expected"]))
     errors = []
     for r in references:
-        if r.get("error") is None:
+        if r["error"] is None:
             errors.append(None)
-        elif r.get("tolerance") is None:
-            errors.append(None if r.get("error_percent") is None else abs(r["error_percent"]))
+        elif r["tolerance"] is None:
+            errors.append(None if r["error_percent"] is None else abs(r["error_percent"]))
         else:
-            scale = largest[r.get("probe")]
+            scale = largest[r["probe"]]
             errors.append(100.0 * abs(r["error"]) / scale if scale else None)
     return errors
 

@@ -53,6 +53,8 @@ def measure(reference: Reference, times: np.ndarray, values: np.ndarray) -> floa
     if kind == "max_abs":
         return float(np.abs(values).max())
     if kind == "at_time":
+        if reference.time > times[-1]:
+            raise ValueError(f"the history ends at t = {times[-1]:.6g}, before the reference's time {reference.time:.6g}")
         return float(np.interp(reference.time, times, values))
     peak_time, peak_value = first_peak(times, values)
     if kind == "first_peak_time":
@@ -61,20 +63,22 @@ def measure(reference: Reference, times: np.ndarray, values: np.ndarray) -> floa
 
 
 def check(reference: Reference, times: np.ndarray, values: np.ndarray) -> dict:
-    """The summary entry of one reference: quantity, computed, expected, error_percent,
-    tolerance (percent or absolute) and passed."""
+    """The summary entry of one reference: quantity, probe, measure, computed, expected,
+    error (absolute and percent), tolerance (percent or absolute), passed and source; when
+    the history cannot give the measure, computed and the errors are None and ``note``
+    says why. Every entry has the same keys."""
+    entry = {"quantity": reference.quantity, "probe": reference.probe, "measure": reference.measure,
+             "computed": None, "expected": reference.expected, "error": None, "error_percent": None,
+             "tolerance_percent": reference.tolerance_percent, "tolerance": reference.tolerance,
+             "passed": False, "source": reference.source}
     try:
         computed = measure(reference, times, values)
     except ValueError as error:
-        return {"quantity": reference.quantity, "computed": None, "expected": reference.expected,
-                "error_percent": None, "passed": False, "note": str(error), "source": reference.source}
+        return entry | {"note": str(error)}
     error = computed - reference.expected
     error_percent = 100.0 * error / reference.expected if reference.expected else None
     if reference.tolerance is not None:
         passed = abs(error) <= reference.tolerance
     else:
         passed = abs(error_percent) <= reference.tolerance_percent
-    return {"quantity": reference.quantity, "probe": reference.probe, "measure": reference.measure,
-            "computed": computed, "expected": reference.expected, "error": error,
-            "error_percent": error_percent, "tolerance_percent": reference.tolerance_percent,
-            "tolerance": reference.tolerance, "passed": bool(passed), "source": reference.source}
+    return entry | {"computed": computed, "error": error, "error_percent": error_percent, "passed": bool(passed)}

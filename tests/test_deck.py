@@ -48,6 +48,12 @@ def problems_of(text: str) -> str:
                      ["section.thickness", "got -0.01", "greater than 0"], id="negative thickness"),
         pytest.param(deck_text(RECTANGLE, '[[boundary]]\ntype = "clamped"\nset = "x_0"\n'),
                      ["boundary[0].set", "unknown set 'x_0'", "did you mean 'x0'"], id="unknown named set"),
+        pytest.param(deck_text(RECTANGLE, '[[output.probe]]\nname = "u"\nquantity = "displacement"\n'
+                                          'set = "x1y1"\ncomponent = "along"\n'),
+                     ["output.probe[0]", "'direction' is needed with component = 'along'"], id="along without direction"),
+        pytest.param(deck_text(RECTANGLE, '[[output.probe]]\nname = "u"\nquantity = "displacement"\n'
+                                          'set = "x1y1"\ncomponent = "radial"\naxis = [0.0, 0.0, 0.0]\n'),
+                     ["output.probe[0]", "axis = [0.0, 0.0, 0.0] has no direction"], id="probe axis of zero length"),
         pytest.param(deck_text(RECTANGLE).replace("nu = 0.3", "nu = 0.5"),
                      ["material.nu", "got 0.5", "got 0.5: a compressible model needs -1 < nu < 0.5"], id="nu >= 0.5"),
         pytest.param(deck_text(RECTANGLE, "[curves.ramp]\nt = [0.0, 2.0, 1.0]\nvalue = [0.0, 1.0, 1.0]\n"),

@@ -384,3 +384,12 @@ def test_an_unstable_run_keeps_its_frames_and_says_why(tmp_path):
     assert summary["status"] == "unstable"
     reader = meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf")
     assert reader.num_steps == summary["frames"] >= 1
+
+
+def test_a_radial_probe_on_its_axis_is_refused_with_a_message():
+    from shellsim.errors import MeshError
+
+    deck = parse_deck(PLATE + '\n[[output.probe]]\nname = "r"\nquantity = "displacement"\nset = "x0y0"\n'
+                              'component = "radial"\n')
+    with pytest.raises(MeshError, match=r"probe 'r': set 'x0y0' has a point on the probe's axis"):
+        prepared(deck)

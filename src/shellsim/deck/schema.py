@@ -241,6 +241,11 @@ TENSOR_QUANTITIES = ("stress", "strain")
 SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
 
 
+#: Components of a vector or tensor probe in cylindrical axes about ``axis`` (through
+#: ``origin``), or along a given ``direction``; a tensor's is its normal component.
+AXIS_COMPONENTS = ("radial", "circumferential", "axial", "along")
+
+
 class Probe(Section):
     """A history written at every output step: ``quantity`` at the node of a point set
     (a set of several nodes gives their mean). ``stress`` (Cauchy), ``strain``
@@ -248,7 +253,13 @@ class Probe(Section):
     point nearest to the set (mean through the thickness, global axes), as stress
     benchmarks compare values at Gauss points. ``face`` reads a position or
     displacement on the bottom or top face (along the director, half the current fibre
-    length from the mid-surface), e.g. the inner radius of a vessel."""
+    length from the mid-surface), e.g. the inner radius of a vessel.
+
+    Vessel axes: ``radial``, ``circumferential`` and ``axial`` components are taken in the
+    cylindrical axes about the line through ``origin`` along ``axis``, at the probe's
+    initial place (a position's radial component is its distance from the axis, a
+    stress's circumferential one the hoop stress); ``along`` takes the component along
+    ``direction``. Over a set of several nodes, each node's component is averaged."""
 
     name: Name
     quantity: Literal[
@@ -257,17 +268,21 @@ class Probe(Section):
     ]
     set: Name
     component: Literal[
-        "x", "y", "z", "magnitude", "xx", "yy", "zz", "xy", "yz", "zx", "scalar"
+        "x", "y", "z", "magnitude", "xx", "yy", "zz", "xy", "yz", "zx", "scalar",
+        "radial", "circumferential", "axial", "along",
     ] = "scalar"
     face: Literal["bottom", "mid", "top"] = "mid"
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    origin: Vec3 = (0.0, 0.0, 0.0)
+    direction: Vec3 | None = None
 
     @model_validator(mode="after")
     def _component_fits(self) -> "Probe":
         if self.face != "mid" and self.quantity not in ("position", "displacement"):
             raise ValueError(f"face = '{self.face}' reads a position or displacement, not {self.quantity}")
         allowed = (
-            ("x", "y", "z", "magnitude") if self.quantity in VECTOR_QUANTITIES
-            else ("xx", "yy", "zz", "xy", "yz", "zx") if self.quantity in TENSOR_QUANTITIES
+            ("x", "y", "z", "magnitude", *AXIS_COMPONENTS) if self.quantity in VECTOR_QUANTITIES
+            else ("xx", "yy", "zz", "xy", "yz", "zx", *AXIS_COMPONENTS) if self.quantity in TENSOR_QUANTITIES
             else ("scalar",)
         )
         if self.component not in allowed:
@@ -275,6 +290,12 @@ class Probe(Section):
                 f"component '{self.component}' does not fit quantity '{self.quantity}'; "
                 f"expected one of {', '.join(allowed)}"
             )
+        if (self.component == "along") != (self.direction is not None):
+            raise ValueError("'direction' is needed with component = 'along', and only then")
+        for key in ("axis", "direction"):
+            vector = getattr(self, key)
+            if vector is not None and not any(vector):
+                raise ValueError(f"{key} = {list(vector)} has no direction; give a nonzero vector")
         return self
 
 

@@ -7,9 +7,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..deck.schema import AXIS_COMPONENTS
 from ..deck.schema import Probe as ProbeTable
 from ..element.kinematics import fibre_point
 from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
+from ..errors import MeshError
 from ..mesh import Mesh
 from ..model import FACES, Model
 
@@ -31,20 +33,51 @@ class Probe:
     element: int = -1
     point: int = -1
     face: float = 0.0  # thickness coordinate t of a position or displacement: -1, 0, +1
+    #: unit vectors of an axis component: (k, 3), one per node, or (3,) at the point
+    directions: np.ndarray | None = None
+    origin: np.ndarray | None = None  # (3,) of the axis, from which positions are taken
+
+
+def axis_directions(table: ProbeTable, places: np.ndarray) -> np.ndarray:
+    """Unit vectors (k, 3) of ``table.component`` (one of AXIS_COMPONENTS) at the initial
+    ``places`` (k, 3): radial, circumferential (axis x radial) or axial about the table's
+    axis through its origin, or its ``direction``. Raises MeshError for a place on the
+    axis, where radial and circumferential are not defined."""
+    if table.component == "along":
+        return np.tile(np.asarray(table.direction) / np.linalg.norm(table.direction), (len(places), 1))
+    axis = np.asarray(table.axis) / np.linalg.norm(table.axis)
+    if table.component == "axial":
+        return np.tile(axis, (len(places), 1))
+    off_axis = places - np.asarray(table.origin)
+    off_axis -= np.outer(off_axis @ axis, axis)
+    distance = np.linalg.norm(off_axis, axis=1)
+    if (distance <= 1e-9 * max(np.abs(places).max(), 1.0)).any():
+        raise MeshError(f"output.probe '{table.name}': set '{table.set}' has a point on the probe's axis, where "
+                        f"'{table.component}' has no direction; move the set or the axis (axis, origin)")
+    radial = off_axis / distance[:, None]
+    return radial if table.component == "radial" else np.cross(axis, radial)
 
 
 def resolve_probes(tables: list[ProbeTable], mesh: Mesh, model: Model) -> list[Probe]:
-    """The deck's probe tables placed on the mesh: nodes of their sets, and for point
-    quantities the integration point nearest to the set's centre."""
+    """The deck's probe tables placed on the mesh: nodes of their sets, for point
+    quantities the integration point nearest to the set's centre, and the directions of
+    axis components at those places."""
     probes = []
+    gauss = model.rule.N[:len(model.rule.wq)]
     for p in tables:
         nodes = mesh.sets[p.set].nodes
         if p.quantity in POINT_QUANTITIES:
-            element, point = nearest_integration_point(model.x0, model.conn, model.rule.N[:len(model.rule.wq)],
-                                                       model.x0[nodes].mean(axis=0))
-            probes.append(Probe(p.name, p.quantity, p.component, nodes, element, point))
+            element, point = nearest_integration_point(model.x0, model.conn, gauss, model.x0[nodes].mean(axis=0))
+            probe = Probe(p.name, p.quantity, p.component, nodes, element, point)
+            places = (gauss[point] @ model.x0[model.conn[element]])[None, :]
         else:
-            probes.append(Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face]))
+            probe = Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face])
+            places = model.x0[nodes]
+        if p.component in AXIS_COMPONENTS:
+            directions = axis_directions(p, places)
+            probe.directions = directions[0] if p.quantity in POINT_QUANTITIES else directions
+            probe.origin = np.asarray(p.origin, dtype=float)
+        probes.append(probe)
     return probes
 
 
@@ -59,17 +92,24 @@ def probe_value(sim, probe: Probe) -> float:
         tensor = thickness_mean((green if probe.quantity == "strain" else cauchy)[0, 0], m.rule.wt, axis=0)
         if probe.quantity == "pressure_band":
             return float(pressure_band(tensor))
+        if probe.directions is not None:
+            return float(probe.directions @ tensor @ probe.directions)
         return float(tensor[TENSOR_COMPONENTS[probe.component]])
     if probe.quantity == "thickness":
         return float(s.h[nodes].mean())
     if probe.quantity == "rotation":
         return float(np.linalg.norm(s.theta[nodes], axis=1).mean())
     if probe.quantity == "director":
-        vector = s.d[nodes].mean(axis=0)
+        vectors = s.d[nodes]
     else:  # a position or displacement on the probe's face
         position = fibre_point(s.x[nodes], s.d[nodes], s.h[nodes, None], probe.face)
         start = fibre_point(m.x0[nodes], m.d0[nodes], m.h0[nodes, None], probe.face)
-        vector = (position if probe.quantity == "position" else position - start).mean(axis=0)
+        vectors = position if probe.quantity == "position" else position - start
+    if probe.directions is not None:  # each node's own component, then their mean
+        if probe.quantity == "position":
+            vectors = vectors - probe.origin
+        return float(np.einsum("ki,ki->k", vectors, probe.directions).mean())
+    vector = vectors.mean(axis=0)
     if probe.component == "magnitude":
         return float(np.linalg.norm(vector))
     return float(vector["xyz".index(probe.component)])

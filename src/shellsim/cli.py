@@ -227,7 +227,7 @@ def _run_report(result: dict, folder: Path) -> Table | str:
     for r in result["reference"]:
         tolerance = f"{r['tolerance_percent']}%" if r["tolerance"] is None else f"{r['tolerance']}"
         error = "-" if r["computed"] is None else (
-            f"{r['error_percent']:+.3f}%" if r.get("error_percent") is not None else f"{r['error']:+.4g}")
+            f"{r['error_percent']:+.3f}%" if r["error_percent"] is not None else f"{r['error']:+.4g}")
         table.add_row(escape(r["quantity"]), "-" if r["computed"] is None else f"{r['computed']:.6g}",
                       f"{r['expected']:.6g}", error, tolerance, "[green]yes" if r["passed"] else "[red]no")
     return table

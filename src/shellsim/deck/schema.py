@@ -456,10 +456,3 @@ class Deck(Section):
         if self.section.thickness_update is not None:
             return self.section.thickness_update
         return self.section.technique is not None
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")

@@ -9,7 +9,6 @@ from __future__ import annotations
 import functools
 import signal
 import sys
-import threading
 from collections.abc import Callable, Iterator
 from contextlib import closing, contextmanager
 from pathlib import Path
@@ -23,6 +22,7 @@ from rich.table import Table
 from . import __version__
 from .errors import OutputError, ShellsimError, Terminated
 from .output.folder import output_folder
+from .signals import handling
 
 app = typer.Typer(
     help="Explicit dynamics of thin and thick soft-tissue shells (9-node continuum-based shell).",
@@ -44,19 +44,13 @@ DeckPath = Annotated[Path, typer.Argument(help="Scene deck (TOML).", show_defaul
 def sigterm_as_interrupt(received: list) -> Iterator[None]:
     """Within the block, SIGTERM raises :class:`Terminated` (a KeyboardInterrupt, so every
     Ctrl-C path closes files and marks the run) and is noted in ``received``."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
 
     def stop(number: int, _frame: Any) -> None:
         received.append(number)
         raise Terminated
 
-    previous = signal.signal(signal.SIGTERM, stop)
-    try:
+    with handling({signal.SIGTERM: stop}):
         yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def reports_errors(command: Callable[..., Any]) -> Callable[..., Any]:

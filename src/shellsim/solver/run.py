@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 import signal
-import threading
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -23,6 +22,7 @@ from ..errors import NumericalError
 from ..mesh import Mesh
 from ..model import Model
 from ..output.probes import Probe, probe_value, resolve_probes
+from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
 from .simulation import Simulation
 
@@ -158,26 +158,14 @@ def _record(run: Run, listener: Listener) -> None:
     listener.on_sample(run)
 
 
-#: Signals that stop a run (Ctrl-C, and SIGTERM where the command line handles it).
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
 @contextmanager
 def interrupt_deferred() -> Iterator[None]:
     """Hold a stop signal that arrives inside the block until the block is done, then
     deliver it to its own handler, so a frame is written to every series and counted, or
-    not at all. (Signal handlers can only be set from the main thread; elsewhere the
-    block runs as it is.)"""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
+    not at all."""
     held = []
-    previous = {number: signal.signal(number, lambda number, _: held.append(number)) for number in STOP_SIGNALS}
-    try:
+    with handling(dict.fromkeys(STOP_SIGNALS, lambda number, _: held.append(number))):
         yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
     for number in dict.fromkeys(held):
         signal.raise_signal(number)
 

@@ -2,6 +2,22 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+#: How many ids a message names before it counts the rest.
+SHOWN_IDS = 5
+
+
+def id_list(ids: Sequence[int]) -> str:
+    """Ids for a message: '3, 8, 12, 20, 31 and 4 more'."""
+    shown = ", ".join(str(int(i)) for i in ids[:SHOWN_IDS])
+    return shown + (f" and {len(ids) - SHOWN_IDS} more" if len(ids) > SHOWN_IDS else "")
+
+
+def place(point: Sequence[float]) -> str:
+    """A point for a message: '(0.5, 1, 0)'."""
+    return "(" + ", ".join(f"{float(c):.6g}" for c in point) + ")"
+
 
 class ShellsimError(Exception):
     """Base of every error that is the user's to fix (bad deck, bad mesh, bad output path)."""

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
-from .errors import MeshError
+from .errors import MeshError, id_list, place
 
 #: Node permutation that reverses an element's orientation (swaps r and s).
 FLIP = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])
@@ -168,18 +168,27 @@ def jacobian_determinants(mesh: Mesh, n_inplane: int = 3, n_thick: int = 2) -> n
     return np.stack(dets, axis=-1)
 
 
-def check_mesh(mesh: Mesh, n_thick: int = 2) -> None:
+def check_mesh(mesh: Mesh, source: str, n_thick: int = 2) -> None:
     """Raise MeshError unless every element has 9 nodes and a positive Jacobian at every
-    Gauss point (3 x 3 in-plane, ``n_thick`` through the thickness)."""
+    Gauss point (3 x 3 in-plane, ``n_thick`` through the thickness). ``source`` names where
+    the mesh came from in the message (a file, a builder); elements count from 1 in its order."""
     if mesh.conn.ndim != 2 or mesh.conn.shape[1] != 9:
-        raise MeshError(f"elements must have 9 nodes, got connectivity of shape {mesh.conn.shape}")
+        raise MeshError(f"{source}: elements must have 9 nodes, got connectivity of shape {mesh.conn.shape}")
     det = jacobian_determinants(mesh, 3, n_thick)
     bad = np.unique(np.nonzero(det <= 0)[0])
-    if len(bad):
-        raise MeshError(
-            f"{len(bad)} element(s) have a non-positive Jacobian (folded, or thicker than "
-            f"their curvature allows), e.g. element {bad[0]} with nodes {mesh.conn[bad[0]].tolist()}"
-        )
+    if not len(bad):
+        return
+    first = bad[0]
+    centre = mesh.x[mesh.conn[first]].mean(axis=0)
+    normal = element_normals(mesh.x, mesh.conn[first:first + 1], NODE_RS)[0]
+    against = np.einsum("ai,ai->a", normal, mesh.director[mesh.conn[first]]) <= 0
+    why = ("its directors point against its surface normal at nodes "
+           f"{id_list(np.flatnonzero(against) + 1)} of 9" if against.any()
+           else "its edges fold or a mid-side node lies outside it, or it is thicker than its curvature allows")
+    raise MeshError(
+        f"{source}: {len(bad)} element(s) have a non-positive Jacobian (an inverted or folded element): "
+        f"elements {id_list(bad + 1)}; element {first + 1} at {place(centre)}: {why}"
+    )
 
 
 def mid_surface_area(mesh: Mesh, n_gauss: int = 3) -> float:

@@ -64,6 +64,7 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
     sets = sets | snap_points(x, deck.mesh.points)
     mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets)
-    check_mesh(mesh, deck.section.points_through_thickness)
+    source = f"mesh file '{path}'" if g.builder == "file" else f"builder '{g.builder}'"
+    check_mesh(mesh, source, deck.section.points_through_thickness)
     return mesh
 

@@ -11,6 +11,9 @@ Point data ``director`` (n, 3) and ``thickness`` (n,) are used when present.
 
 from __future__ import annotations
 
+import contextlib
+import io
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,11 +21,17 @@ import numpy as np
 
 from ..errors import MeshError
 from ..mesh import NamedSet, edges_within
+from .file_checks import (
+    GMSH_QUAD9, collapsed_problem, missing_nodes_problem, normalised, point_data_problems, repeated_node_problem,
+)
 
 SET_PREFIX = "set_"
 KIND_CODE = {"point": 1, "edge": 2, "surface": 3}
 _KIND_OF_CODE = {v: k for k, v in KIND_CODE.items()}
 _KIND_OF_CELL = {"quad9": "surface", "line3": "edge", "line": "edge", "vertex": "point"}
+#: Surface and volume cells other than quad9: a file holding them is not a quad9 shell mesh.
+_NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", "tetra", "tetra10", "hexahedron",
+              "hexahedron20", "hexahedron27", "wedge", "pyramid"}
 
 
 @dataclass(frozen=True)
@@ -38,24 +47,40 @@ class ImportedMesh:
 
 
 def _read(path: Path):
+    """meshio's mesh of ``path``. meshio prints its complaints and calls ``sys.exit`` on a file
+    it cannot parse (which would end a study's worker): both are caught and become the message."""
     import meshio
 
     if not path.is_file():
         raise MeshError(f"mesh file '{path}' not found")
+    said = io.StringIO()
     try:
-        return meshio.read(path)
-    except Exception as err:  # meshio raises many types for unreadable files
-        raise MeshError(f"mesh file '{path}' could not be read: {err}") from None
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            mesh = meshio.read(path)
+    except (Exception, SystemExit) as err:  # meshio raises many types for unreadable files
+        complaints = " ".join(line.strip() for line in said.getvalue().splitlines() if line.strip())
+        reason = "; ".join(part for part in (complaints, str(err) if not isinstance(err, SystemExit) else "") if part)
+        raise MeshError(f"mesh file '{path}' could not be read (truncated, or not a mesh?): {reason}") from None
+    sys.stderr.write(said.getvalue())
+    return mesh
 
 
 def read_mesh(path: Path) -> ImportedMesh:
-    """Read a quad9 mesh and its named sets; nodes not used by any quad are dropped."""
+    """Read a quad9 mesh and its named sets; nodes not used by any quad are dropped.
+
+    Raises MeshError, naming every defect with ids and places, for a file that is not a
+    quad9 shell mesh or whose nodes, directors, thicknesses or elements cannot be used.
+    """
     m = _read(Path(path))
     blocks = [i for i, block in enumerate(m.cells) if block.type == "quad9"]
-    if not blocks:
+    others = sorted({b.type for b in m.cells if b.type in _NOT_QUAD9})
+    if not blocks or others:
         found = ", ".join(sorted({b.type for b in m.cells})) or "no cells"
-        raise MeshError(f"mesh file '{path}' has no 9-node quadrilaterals (quad9); found {found}")
-    conn_raw = np.concatenate([m.cells[i].data for i in blocks])
+        what = "no 9-node quadrilaterals (quad9)" if not blocks else f"elements other than quad9 ({', '.join(others)})"
+        raise MeshError(f"mesh file '{path}' has {what}; found {found}. To {GMSH_QUAD9}")
+    _refuse(path, [p for block in m.cells
+                   for p in missing_nodes_problem(block.type, np.asarray(block.data, dtype=np.int64), len(m.points))])
+    conn_raw = np.concatenate([np.asarray(m.cells[i].data, dtype=np.int64) for i in blocks])
     used = np.unique(conn_raw)
     index = np.full(len(m.points), -1)
     index[used] = np.arange(len(used))
@@ -64,6 +89,23 @@ def read_mesh(path: Path) -> ImportedMesh:
         x = np.column_stack([x, np.zeros(len(x))])
     conn = index[conn_raw]
     offsets = np.cumsum([0] + [len(m.cells[i].data) for i in blocks])
+
+    def point_array(name: str, width: int | None) -> np.ndarray | None:
+        if name not in m.point_data:
+            return None
+        values = np.asarray(m.point_data[name], dtype=float)
+        if values.size != len(m.points) * (width or 1):
+            raise MeshError(f"mesh file '{path}': point data '{name}' has {values.size} values for "
+                            f"{len(m.points)} nodes; expected {width or 1} per node")
+        return values.reshape(len(m.points), width)[used] if width else values.reshape(len(m.points))[used]
+
+    director, thickness = point_array("director", 3), point_array("thickness", None)
+    problems = repeated_node_problem(conn_raw) + point_data_problems(x, director, thickness, node_ids=used + 1)
+    if not problems:
+        problems = collapsed_problem(x, conn)
+    _refuse(path, problems)
+    if director is not None:
+        director = normalised(director)
 
     sets: dict[str, NamedSet] = {}
     for name, per_block in m.cell_sets.items():
@@ -82,20 +124,22 @@ def read_mesh(path: Path) -> ImportedMesh:
                 nodes = index[np.asarray(block.data[cells])]
                 nodes = nodes[(nodes >= 0).all(axis=-1)] if nodes.ndim > 1 else nodes[nodes >= 0]
                 sets[name] = _node_set(kind, np.unique(nodes), conn)
-    for key, values in m.point_data.items():
+    for key in m.point_data:
         if key.startswith(SET_PREFIX):
-            values = np.asarray(values)[used]
+            values = np.nan_to_num(point_array(key, None))
             code = int(values.max(initial=0))
             if code in _KIND_OF_CODE:
                 sets[key[len(SET_PREFIX):]] = _node_set(_KIND_OF_CODE[code], np.flatnonzero(values), conn)
 
-    def point_array(name: str, width: int | None) -> np.ndarray | None:
-        if name not in m.point_data:
-            return None
-        values = np.asarray(m.point_data[name], dtype=float)[used]
-        return values.reshape(len(used), width) if width else values.reshape(len(used))
+    return ImportedMesh(x, conn, sets, director, thickness)
 
-    return ImportedMesh(x, conn, sets, point_array("director", 3), point_array("thickness", None))
+
+def _refuse(path: Path, problems: list[str]) -> None:
+    """Raise MeshError listing ``problems``, if there are any."""
+    if problems:
+        count = f"{len(problems)} problem{'s' if len(problems) > 1 else ''}"
+        raise MeshError(f"mesh file '{path}' cannot be used ({count}; ids count from 1 in the file's order):\n"
+                        + "\n".join(f"  - {p}" for p in problems))
 
 
 def _node_set(kind: str, nodes: np.ndarray, conn: np.ndarray) -> NamedSet:

@@ -197,6 +197,32 @@ BUILDERS = {
 }
 
 
+#: How far apart a builder's lengths may be: beyond this its elements are slivers, and
+#: gmsh merges points closer than 1e-8 of the model's size.
+LENGTH_RATIO = 1e6
+
+
+def lengths(geometry: Section) -> dict[str, float]:
+    """A builder's lengths by key: its numbers other than angles (none for a mesh file)."""
+    return {k: v for k, v in geometry.model_dump().items() if isinstance(v, float) and not k.endswith("_deg")}
+
+
+def proportion_problems(geometry: Section, thickness: float) -> list[str]:
+    """Lengths too far apart to mesh, and a section thicker than the model is large."""
+    sizes = lengths(geometry)
+    if not sizes:
+        return []
+    big, small = max(sizes, key=sizes.get), min(sizes, key=sizes.get)
+    problems = []
+    if sizes[big] > LENGTH_RATIO * sizes[small]:
+        problems.append(f"geometry.{small} = {sizes[small]:g} and geometry.{big} = {sizes[big]:g} are more than "
+                        f"{LENGTH_RATIO:g} times apart; the elements would be slivers (check the units)")
+    if thickness > sizes[big]:
+        problems.append(f"section.thickness = {thickness:g} is larger than the model itself (geometry.{big} = "
+                        f"{sizes[big]:g}); a shell's thickness is small against its extent (check the units)")
+    return problems
+
+
 def _edges(*names: str) -> SetKinds:
     return {n: "edge" for n in names}
 

@@ -12,7 +12,7 @@ from typing import Annotated, ClassVar, Literal, Union
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from .curves import Curve
-from .geometry import BUILDERS, Geometry
+from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
 from .types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
 
@@ -446,6 +446,7 @@ class Deck(Section):
             )
         if self.material.HYPERELASTIC and self.section.technique is None:
             problems.append("section.technique: a hyperelastic material needs a large-strain technique (1, 2 or 3)")
+        problems += proportion_problems(self.geometry, self.section.thickness)
         if problems:
             raise ValueError("\n".join(problems))
         return self

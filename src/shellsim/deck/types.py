@@ -6,11 +6,25 @@ from __future__ import annotations
 import typing
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
-Real = Annotated[float, Field(strict=True, allow_inf_nan=False)]
-Positive = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False)]
+#: The magnitudes a deck's numbers may have. Products of a few of them (a stiffness E h^3,
+#: a frequency E / (rho L^2), an energy) must stay far inside double precision, and no
+#: unit system puts a physical quantity of a shell model outside this range.
+SMALLEST, LARGEST = 1e-30, 1e30
+
+
+def _within_range(value: float) -> float:
+    if value != 0 and not SMALLEST <= abs(value) <= LARGEST:
+        raise ValueError(f"expected a magnitude between {SMALLEST:g} and {LARGEST:g} (or 0 where 0 is allowed); "
+                         "choose units that keep the deck's numbers nearer 1")
+    return value
+
+
+_IN_RANGE = AfterValidator(_within_range)
+Real = Annotated[float, Field(strict=True, allow_inf_nan=False), _IN_RANGE]
+Positive = Annotated[float, Field(strict=True, gt=0, allow_inf_nan=False), _IN_RANGE]
+NonNegative = Annotated[float, Field(strict=True, ge=0, allow_inf_nan=False), _IN_RANGE]
 Count = Annotated[int, Field(strict=True, ge=1)]
 Vec3 = tuple[Real, Real, Real]
 #: Names of sets, curves and probes: a letter first, then letters, digits, '_' or '-'.

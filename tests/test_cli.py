@@ -46,6 +46,48 @@ def test_check_warns_about_a_safety_factor_below_one(tmp_path):
     assert "unstable" in result.output
 
 
+def test_magnitudes_outside_any_unit_system_and_disproportionate_sizes_are_refused(tmp_path):
+    deck = tmp_path / "absurd.toml"
+    plate = 'builder = "rectangle"\nlength = 2.0\nwidth = 1e-7'
+    deck.write_text(deck_text(plate).replace("E = 1000.0", "E = 1e300"))
+    result = runner.invoke(app, ["check", str(deck)])
+    assert result.exit_code == 2
+    assert "material.E (line 7): got 1e+300: expected a magnitude between 1e-30 and 1e+30" in result.output
+    deck.write_text(deck_text(plate).replace("thickness = 0.01", "thickness = 5.0"))
+    result = runner.invoke(app, ["check", str(deck)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2
+    assert "geometry.width = 1e-07 and geometry.length = 2 are more than 1e+06 times apart" in said
+    assert "section.thickness = 5 is larger than the model itself (geometry.length = 2)" in said
+
+
+def test_a_scene_that_would_take_years_is_refused_by_check_and_run(tmp_path):
+    """A 1e-20 thick plate has a critical step near 1e-23 of the end time: check shows the
+    scene and refuses it; run refuses before the first step and says so in its summary."""
+    import json
+
+    deck = tmp_path / "hopeless.toml"
+    deck.write_text(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace("thickness = 0.01",
+                                                                                          "thickness = 1e-20"))
+    checked = runner.invoke(app, ["check", str(deck)])
+    assert checked.exit_code == 2 and "steps to the end" in checked.output
+    assert "years on this machine" in " ".join(checked.output.split())
+    ran = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert ran.exit_code == 2 and "years on this machine" in " ".join(ran.output.split())
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"] == "refused" and summary["steps"] == 0
+
+
+def test_a_mesh_larger_than_the_memory_is_refused_after_meshing(tmp_path, monkeypatch):
+    from shellsim.solver import outlook
+
+    monkeypatch.setattr(outlook, "available_bytes", lambda: 1e8)
+    result = runner.invoke(app, ["check", str(DEFAULT_DECK)])
+    assert result.exit_code == 2
+    assert "the mesh has 19 elements: a run needs about 400 MB of memory and 100 MB is available" in \
+        " ".join(result.output.split())
+
+
 def test_check_gives_the_step_and_suggests_m1_for_a_thin_shell_on_m2(tmp_path):
     thin = ROOT / "decks" / "stability" / "thin_plate_1e-3.toml"
     shipped = runner.invoke(app, ["check", str(thin)])  # M1: no hint

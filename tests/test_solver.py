@@ -87,6 +87,22 @@ def test_a_critical_step_estimate_over_budget_errs_on_the_safe_side(monkeypatch)
     assert converged * (1 - timestep.TOLERANCE) <= bounded <= converged * (1 + 10 * timestep.COARSE_TOLERANCE)
 
 
+def test_a_degenerate_operator_is_a_message_not_an_arpack_error():
+    """No stiffness at all (every product zero: ARPACK cannot start) and masses that are no
+    number each end in NumericalError saying what is degenerate and what to check."""
+    from shellsim.solver import timestep
+
+    sim = prepared(parse_deck(PLATE.read_text())).sim
+    sim.update_masses()
+    zero = sim.compiled._replace(stiffness=lambda *args: [a.fill(0.0) for a in args[7:9]])
+    sim.compiled = zero
+    with pytest.raises(NumericalError, match=r"could not be estimated at t = 0: .*check the magnitudes of material.E"):
+        timestep.largest_eigenvalue(sim)
+    sim.state.mt[3] = np.nan
+    with pytest.raises(NumericalError, match=r"lumped masses of 1 nodes \(first, counting from 1: \[4\]\)"):
+        timestep.largest_eigenvalue(sim)
+
+
 def test_a_step_above_the_critical_one_is_stopped_with_a_clear_message():
     deck = parse_deck(PLATE.read_text().replace("[solver]\n", "[solver]\ndt_safety_factor = 0.8\n"))
     with pytest.raises(NumericalError, match=r"unstable.*dt_safety_factor = 0.8 < 1"):
@@ -135,3 +151,76 @@ def test_reference_measures_and_tolerances():
     assert check(Reference(**ref, measure="at_time", time=0.5, tolerance_percent=0.1), t, values)["passed"]
     assert not check(Reference(**ref, measure="final", tolerance_percent=10.0), t, values)["passed"]
     assert check(Reference(**ref | {"expected": 2.05}, measure="max", tolerance=0.1), t, values)["passed"]
+
+
+FOLDING = """
+[meta]
+title = "a corner driven through its element"
+
+[geometry]
+builder = "rectangle"
+length = 1.0
+width = 1.0
+
+[material]
+model = "linear_elastic"
+E = 1000.0
+nu = 0.3
+density = 1.0
+
+[section]
+thickness = 0.01
+
+[[boundary]]
+type = "clamped"
+set = "x0"
+
+[[boundary]]
+type = "prescribed"
+set = "x1y1"
+translation = "x"
+value = -1.5
+curve = "ramp"
+
+[[boundary]]
+type = "prescribed"
+set = "x1y1"
+translation = "y"
+value = -1.5
+curve = "ramp"
+
+[curves.ramp]
+t = [0.0, 1.0]
+value = [0.0, 1.0]
+
+[solver]
+end_time = 1.0
+"""
+
+
+def test_a_folding_element_is_named_as_the_cause_and_its_frame_kept(tmp_path):
+    """The corner node of a 2 x 2 plate is driven diagonally through its element (number 4,
+    centred at (0.75, 0.75)): the run must blame that element, not the time step, and keep
+    the breaking state as the series' last frame."""
+    import meshio
+
+    deck = tmp_path / "fold.toml"
+    deck.write_text(FOLDING)
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 3, result.output
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    message = summary["message"]
+    assert "element 4 (counting from 1) at (0.75, 0.75, 0) has folded over" in message
+    assert "refine the mesh around that element" in message and "dt_safety_factor" not in message
+    assert summary["element_quality"]["lowest"]["element"] == 4
+    assert summary["element_quality"]["lowest"]["ratio"] <= 0
+    reader = meshio.xdmf.TimeSeriesReader(tmp_path / "out" / "results.xdmf")
+    assert reader.num_steps == summary["frames"] >= 2
+    reader.read_points_cells()
+    last_time, _, _ = reader.read_data(reader.num_steps - 1)
+    assert last_time == pytest.approx(summary["breaking_frame_time"]) == pytest.approx(summary["sim_time"])
+
+
+def test_the_worst_element_of_an_undistorted_run_keeps_its_volume(plate_run):
+    """Small bending of a plate barely changes any element's volume: the watch reads 1."""
+    assert plate_run.lowest is not None and abs(plate_run.lowest.ratio - 1.0) < 1e-3

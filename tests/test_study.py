@@ -15,7 +15,7 @@ from shellsim.errors import DeckError
 from shellsim.study.jobs import Job, apply_overrides, as_expected, row
 from shellsim.study.report import read_external, table
 
-from .conftest import ROOT, STUDIES
+from .conftest import BASE, ROOT, STUDIES
 
 runner = CliRunner()
 QUICK = ROOT / "decks" / "studies" / "quick.toml"
@@ -173,3 +173,50 @@ def test_an_absolute_tolerance_counts_its_error_against_the_largest_value_on_its
     ]
     summary = SUMMARY | {"reference": references}
     assert row(Job("f", "v", Path("d.toml"), {}, Path("out")), summary)["error_percent"] == pytest.approx(1.0)
+
+
+def test_an_unreachable_scheduler_is_named_within_seconds(tmp_path):
+    import time
+
+    started = time.perf_counter()
+    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path / "out"),
+                                 "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", "2"])
+    assert time.perf_counter() - started < 10.0
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert "the dask scheduler at 'tcp://127.0.0.1:1' did not answer within 2 s" in " ".join(result.output.split())
+
+
+def test_a_truncated_mesh_is_a_failed_row_and_a_dying_worker_is_named(tmp_path):
+    """A job reading a truncated mesh file (meshio calls sys.exit on it) is a failed row with
+    the reason, and its worker lives on (same process before and after); a job whose worker
+    dies is one failed row naming the job, not four workers taken down in turn."""
+    import os
+
+    from shellsim.study.executor import open_client, run_jobs
+    from shellsim.study.jobs import study_jobs
+    from shellsim.study.schema import load_study
+
+    from .test_mesh_files import write_mesh
+
+    def kill_own_worker(job, threads):  # nested, so dask ships it by value
+        import signal
+
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    write_mesh(tmp_path / "whole.vtu", [])
+    (tmp_path / "cut.vtu").write_bytes((tmp_path / "whole.vtu").read_bytes()[:700])
+    (tmp_path / "cut.toml").write_text(BASE + '[geometry]\nbuilder = "file"\npath = "cut.vtu"\n')
+    study = tmp_path / "study.toml"
+    study.write_text('[meta]\ntitle = "a truncated mesh"\n\n[[deck]]\npath = "cut.toml"\n\n'
+                     '[[deck.variant]]\nlabel = "cut"\n')
+    jobs = study_jobs(load_study(study), study, tmp_path / "out")
+    rows: list[dict] = []
+    with open_client(None, 1) as client:
+        before = client.run(os.getpid)
+        run_jobs(jobs, client, rows.append, threads=1)
+        after = client.run(os.getpid)
+        run_jobs(jobs, client, rows.append, threads=1, work=kill_own_worker)
+    assert rows[0]["status"] == "failed" and "could not be read" in rows[0]["message"]
+    assert before == after
+    assert rows[1]["status"] == "failed" and "the worker process running this job" in rows[1]["message"]
+    assert "variant 'cut'" in rows[1]["message"]

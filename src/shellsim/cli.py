@@ -20,7 +20,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from . import __version__
-from .errors import OutputError, ShellsimError, Terminated
+from .errors import OutputError, SceneTooLarge, ShellsimError, Terminated
 from .output.folder import output_folder
 from .signals import handling
 
@@ -96,13 +96,21 @@ def check(deck: DeckPath) -> None:
     from .geometry import build_mesh
     from .model import build_model
     from .plan import plan
-    from .solver.run import step_outlook
+    from .solver.outlook import memory_bytes, refuse_if_hopeless, refuse_if_too_big, size_text, step_outlook
 
     scene = load_deck(deck)
-    mesh = build_mesh(scene, deck.parent)
-    with err.status("estimating the critical time step (the first use compiles the kernels, about a minute)"):
-        outlook = step_outlook(scene, build_model(scene, mesh))
+    with err.status("meshing") as status:
+        mesh = build_mesh(scene, deck.parent)
+        err.print(f"{mesh.n_elements:,} elements, {mesh.n_nodes:,} nodes: a run holds about "
+                  f"{size_text(memory_bytes(mesh.n_elements))}", highlight=False)
+        refuse_if_too_big(mesh.n_elements)
+        status.update("building the model")
+        model = build_model(scene, mesh)
+        status.update("estimating the critical time step (the first use compiles the kernels, about two minutes)")
+        outlook = step_outlook(scene, model, lambda count: status.update(
+            f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
+    refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
     if scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(
             f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "
@@ -175,10 +183,12 @@ def run(
     scene = load_deck(deck)
     folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
     with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress:
-        current, result = run_scene(scene, deck, folder, progress)
+        current, result = run_scene(scene, deck, folder, progress, progress.announce)
     message = result["message"]
     if current.status == "interrupted":
         raise KeyboardInterrupt
+    if current.status == "refused":
+        raise SceneTooLarge(message)
     if current.status == "output failed":
         raise OutputError(message)
     if current.status == "completed":
@@ -290,6 +300,7 @@ def report(
     scheduler: Annotated[str | None, typer.Option(help="A running dask scheduler, tcp://HOST:PORT "
                                                        "[default: a local cluster].")] = None,
     workers: Annotated[int | None, typer.Option(min=1, help="Workers of the local cluster [default: one per core].")] = None,
+    connect_timeout: Annotated[float, typer.Option(min=0.1, help="Seconds to wait for --scheduler to answer.")] = 5.0,
     embed_in: Annotated[Path | None, typer.Option("--embed", help="Also write the table into this markdown file, "
                                                   "between '<!-- report STUDY-NAME -->' and "
                                                   "'<!-- end report STUDY-NAME -->'.")] = None,
@@ -313,7 +324,7 @@ def report(
     external = read_external(study.parent / plan_.external.path) if plan_.external else []
     rows: list[dict] = []
     write_report(folder, plan_.meta.title, rows, len(jobs), external)
-    with open_client(scheduler, workers) as client, Progress(console=out, transient=True) as bar:
+    with open_client(scheduler, workers, connect_timeout) as client, Progress(console=out, transient=True) as bar:
         prepare_workers(client, local=scheduler is None)
         task = bar.add_task(f"{len(jobs)} jobs", total=len(jobs))
 
@@ -393,6 +404,8 @@ THIN_SHELL_GAIN = 2.0
 
 
 def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
+    from .solver.outlook import duration, size_text
+
     table = Table(title=scene.meta.title, show_header=False, title_justify="left")
     table.add_column(style="bold")
     table.add_column()
@@ -424,6 +437,9 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                             + (f", damping {sv.damping}/s" if sv.damping else ""))
     table.add_row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
                                f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
+    table.add_row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
+                          f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
+                          f"{size_text(outlook['bytes'])} of memory")
     for ref in scene.reference:
         tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
         table.add_row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "

@@ -54,6 +54,14 @@ class NumericalError(ShellsimError):
     """A run that went unstable (NaN, energy blow-up); what it wrote so far is kept."""
 
 
+class SceneTooLarge(ShellsimError):
+    """A valid deck whose scene cannot fit in memory or finish in any reasonable time."""
+
+
+class StudyError(ShellsimError):
+    """A study that cannot go on (its scheduler does not answer) or a job whose worker died."""
+
+
 class NotYetAvailable(ShellsimError):
     """A command whose work is planned but not built yet."""
 

@@ -3,27 +3,36 @@ and each job of a study call."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import ExitStack, closing
 from pathlib import Path
 
 from . import __version__
 from .deck import Deck
-from .errors import NumericalError, OutputError
+from .errors import NumericalError, OutputError, SceneTooLarge
 from .solver.run import Listener, Listeners, Run, Stopwatch, Timed
 
 
-def built_run(scene: Deck, deck_folder: Path) -> Run:
+def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = lambda text: None) -> Run:
     """A run of ``scene`` ready to start (mesh, model, simulation; files named in the deck
     are read relative to ``deck_folder``), with the seconds each took in ``run.startup``:
     mesh_s, model_s, and kernels_s, the first masses and forces (the kernels compiled, or
-    loaded from numba's cache). :func:`shellsim.solver.run.integrate` adds first_dt_s."""
+    loaded from numba's cache). :func:`shellsim.solver.run.integrate` adds first_dt_s.
+    ``announce`` hears each stage and the mesh's size. Raises SceneTooLarge for a mesh
+    that would not fit in memory."""
     from .geometry import build_mesh
     from .model import build_model
+    from .solver.outlook import memory_bytes, refuse_if_too_big, size_text
     from .solver.run import prepare
 
     clock = Stopwatch()
+    announce("meshing")
     mesh = build_mesh(scene, deck_folder)
     mesh_s = clock.lap()
+    announce(f"{mesh.n_elements:,} elements, {mesh.n_nodes:,} nodes, {5 * mesh.n_nodes:,} DOFs: "
+             f"about {size_text(memory_bytes(mesh.n_elements))} of memory")
+    refuse_if_too_big(mesh.n_elements)
+    announce("building the model; then the kernels (compiled on first use, about two minutes)")
     model = build_model(scene, mesh)
     model_s = clock.lap()
     run = prepare(scene, mesh, model)
@@ -31,12 +40,14 @@ def built_run(scene: Deck, deck_folder: Path) -> Run:
     return run
 
 
-def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None) -> tuple[Run, dict]:
+def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
+              announce: Callable[[str], None] = lambda text: None) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
     (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
     and summary.json whatever the end. Returns (run, summary); ``run.status`` tells how it
-    ended ('completed', 'unstable', 'interrupted', 'output failed') and the summary's
-    ``message`` why. Renders are left to the caller."""
+    ended ('completed', 'unstable', 'interrupted', 'output failed', 'refused': too long to
+    run) and the summary's ``message`` why. ``announce`` hears the stages before the first
+    step. Renders are left to the caller."""
     from .deck.resolved import RESOLVED_NAME, resolved_text
     from .output.folder import write_atomically
     from .output.history import HistoryWriter
@@ -45,7 +56,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .plan import plan
     from .solver.run import integrate, output_times
 
-    current = built_run(scene, deck_path.parent)
+    current = built_run(scene, deck_path.parent, announce)
     write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
     message = None
     with ExitStack() as files:
@@ -55,7 +66,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
         writers = Timed(Listeners(history, frames))
         try:
             integrate(current, Listeners(writers, progress or Listener()))
-        except NumericalError as error:
+        except (NumericalError, SceneTooLarge) as error:
             message = str(error)
         except KeyboardInterrupt as stop:
             message = str(stop) or "interrupted by the user"

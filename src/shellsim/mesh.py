@@ -150,14 +150,24 @@ def combine_surface_normals(reference: np.ndarray, pieces: list[tuple[np.ndarray
 
 
 def jacobian_determinants(mesh: Mesh, n_inplane: int = 3, n_thick: int = 2) -> np.ndarray:
+    """det of the 3D Jacobian at the Gauss points of the mesh as built: (ne, n_inplane**2, n_thick);
+    see :func:`body_jacobians`."""
+    return body_jacobians(mesh.x, mesh.conn, mesh.director, mesh.thickness, n_inplane, n_thick)
+
+
+def body_jacobians(x: np.ndarray, conn: np.ndarray, director: np.ndarray, thickness: np.ndarray,
+                   n_inplane: int = 3, n_thick: int = 2) -> np.ndarray:
     """det of the 3D Jacobian [dx/dr, dx/ds, dx/dt] of the shell body at the Gauss points,
-    x(r, s, t) = sum_a N_a (x_a + t h_a/2 d_a). Returns (ne, n_inplane**2, n_thick)."""
+    x(r, s, t) = sum_a N_a (x_a + t h_a/2 d_a), for any shape of it (initial or current).
+
+    Shapes: x (n, 3), conn (ne, 9), director (n, 3), thickness (n,) -> (ne, n_inplane**2, n_thick).
+    """
     rs, _ = gauss_rule_2d(n_inplane)
     t, _ = gauss_rule(n_thick)
     n = shape(rs)  # (q, 9)
     dn = shape_derivatives(rs)  # (q, 9, 2)
-    xe = mesh.x[mesh.conn]  # (ne, 9, 3)
-    fibre = (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]  # (ne, 9, 3)
+    xe = x[conn]  # (ne, 9, 3)
+    fibre = (0.5 * thickness[:, None] * director)[conn]  # (ne, 9, 3)
     g = np.einsum("qad,eai->eqdi", dn, xe)  # (ne, q, 2, 3)
     gf = np.einsum("qad,eai->eqdi", dn, fibre)  # (ne, q, 2, 3)
     f = np.einsum("qa,eai->eqi", n, fibre)  # (ne, q, 3) = dx/dt

@@ -1,11 +1,13 @@
 """Progress of a run: a rich bar on a terminal (simulated time, step, steps per second,
-energy balance, time left), a line every tenth of the run otherwise, nothing when quiet."""
+energy balance, the worst element's Jacobian ratio J/J0, time left), a line every tenth of
+the run otherwise, nothing when quiet."""
 
 from __future__ import annotations
 
 import time
 
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from ..solver.run import Listener, Run
@@ -22,10 +24,27 @@ class ProgressDisplay(Listener):
         if not quiet and console.is_terminal:
             self.bar = Progress(TextColumn("[bold]t = {task.fields[t]}"), BarColumn(),
                                 TextColumn("dt {task.fields[dt]}  {task.fields[rate]} steps/s  "
-                                           "balance {task.fields[balance]}"),
+                                           "balance {task.fields[balance]}  J/J0 {task.fields[quality]}"),
                                 TimeRemainingColumn(), console=console, transient=True)
-            self.task = self.bar.add_task("run", total=end_time, t="0", dt="-", rate="-", balance="-")
+            self.task = self.bar.add_task("run", total=end_time, t="0", dt="-", rate="-", balance="-", quality="-")
             self.bar.start()
+
+    def announce(self, text: str) -> None:
+        """A stage of the work before the first step (meshing, the mesh's size, building)."""
+        if not self.quiet:
+            self.console.print(f"[dim]{escape(text)}[/]", highlight=False)
+
+    def on_dt(self, run: Run) -> None:
+        """At the first estimate: the step and what the run will cost."""
+        if self.quiet or len(run.dt_history) != 1:
+            return
+        from ..solver.outlook import duration, seconds_per_step
+
+        steps = run.deck.solver.end_time / run.dt
+        cost = steps * seconds_per_step(run.model.n_elements)
+        self.announce(f"critical step {run.dt_critical:.4g}, step {run.dt:.4g}: about {steps:,.0f} steps, "
+                      f"about {duration(cost)} of stepping ({duration(cost / run.deck.solver.end_time)} "
+                      "per unit of simulated time)")
 
     def _fields(self, run: Run) -> dict:
         elapsed = max(time.perf_counter() - self.started, 1e-9)
@@ -33,7 +52,8 @@ class ProgressDisplay(Listener):
         scale = max(abs(e[2]), 1e-300)
         return {"t": f"{run.sim.state.t:.4g}", "dt": f"{run.dt:.3g}",
                 "rate": f"{run.sim.state.steps / elapsed:,.0f}",
-                "balance": f"{100 * run.balance_error / scale:+.2f}%"}
+                "balance": f"{100 * run.balance_error / scale:+.2f}%",
+                "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
 
     def on_sample(self, run: Run) -> None:
         if self.quiet:
@@ -43,7 +63,8 @@ class ProgressDisplay(Listener):
         elif run.sim.state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
             f = self._fields(run)
             self.console.print(f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
-                               f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}", highlight=False)
+                               f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}, worst J/J0 {f['quality']}",
+                               highlight=False)
             self.next_line += 0.1
 
     def close(self) -> None:

@@ -50,6 +50,8 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "us_per_element_step": 1e6 * (run.wall_time - output_seconds) / (steps * model.n_elements),
         "startup_s": run.startup,
         "dt": dt_statistics(run),
+        "element_quality": element_quality(run),
+        "breaking_frame_time": run.breaking_frame,
         "energy": {
             "internal": float(e[INTERNAL]), "kinetic": float(e[KINETIC]),
             "external_work": float(e[EXTERNAL]), "damping_work": float(e[DAMPED]),
@@ -60,6 +62,16 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         **large_strain,
         "reference": reference_results(run),
     }
+
+
+def element_quality(run: Run) -> dict:
+    """The worst element's Jacobian ratio (det J / det J0, 1 undistorted, 0 folded) at the
+    last step update and the lowest over the run, each with the element (from 1) and time."""
+
+    def entry(worst) -> dict | None:
+        return None if worst is None else {"element": worst.element + 1, "ratio": worst.ratio, "t": worst.t}
+
+    return {"last": entry(run.worst), "lowest": entry(run.lowest)}
 
 
 def write_json(data: dict, path: Path) -> None:

@@ -12,18 +12,20 @@ import math
 import signal
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..deck import Deck
-from ..errors import NumericalError
+from ..errors import NumericalError, OutputError, SceneTooLarge
 from ..mesh import Mesh
 from ..model import Model
 from ..output.probes import Probe, probe_value, resolve_probes
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
+from .outlook import refuse_if_hopeless
+from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
 
 #: History samples over a run (fewer when the run has fewer steps).
@@ -51,6 +53,11 @@ class Run:
     wall_time: float = 0.0
     status: str = "running"
     startup: dict[str, float] = field(default_factory=dict)  # fixed costs before stepping [s]
+    quality: ElementQuality | None = None
+    ratios: np.ndarray | None = None  # each element's Jacobian ratio at the last step update
+    worst: Worst | None = None  # the worst element at the last step update
+    lowest: Worst | None = None  # the worst element seen over the run
+    breaking_frame: float | None = None  # time of the frame written as the run broke down
 
     @property
     def balance_error(self) -> float:
@@ -130,7 +137,8 @@ class Timed(Listener):
 def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     """A run ready to start: simulation built, probes resolved."""
     probes = resolve_probes(deck.output.probe, mesh, model)
-    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes)
+    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
+              quality=ElementQuality(mesh))
     run.history = {p.name: [] for p in probes}
     return run
 
@@ -178,8 +186,12 @@ def _frame(run: Run, listener: Listener) -> None:
 
 def _update_time_step(run: Run, listener: Listener) -> None:
     solver = run.deck.solver
+    s = run.sim.state
+    run.ratios = run.quality.ratios(s.x, s.d, s.h)
+    run.worst = run.quality.worst(s.t, run.ratios)
+    if run.lowest is None or not run.worst.ratio >= run.lowest.ratio:
+        run.lowest = run.worst
     run.sim.update_masses()
-    _check_masses(run)
     run.dt_critical = run.sim.critical_time_step()
     run.dt = run.dt_critical / solver.dt_safety_factor
     if solver.dt_max is not None:
@@ -198,20 +210,32 @@ def _check_stability(run: Run) -> None:
     if broken:
         raise NumericalError(
             f"the run became unstable at t = {s.t:.6g} after {s.steps} steps: energy is being "
-            f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()})"
-            f"{_time_step_hint(run)}")
+            f"created (balance error {run.balance_error:.3g}, energies {e.round(6).tolist()})")
 
 
-def _check_masses(run: Run) -> None:
-    """The lumped masses, taken on the current shape, are positive: an element folded
-    over has a negative volume, and the critical step of such masses is no number."""
+def _breakdown_cause(run: Run) -> str:
+    """Why the run broke down: the crushed or folded elements and where they are if the
+    mesh has given way (its state now, or at the last step update if now is no number),
+    else the time step; and how the critical step moved just before."""
     s = run.sim.state
-    bad = np.flatnonzero(~(s.mt > 0.0) | ~(s.mr > 0.0))
-    if bad.size:
-        raise NumericalError(
-            f"the run broke down at t = {s.t:.6g} after {s.steps} steps: the lumped masses of {bad.size} "
-            f"nodes (first: {bad[:5].tolist()}) are not positive, so an element around them has folded over"
-            f"{_time_step_hint(run)}")
+    ratios = run.ratios
+    if np.isfinite(s.x).all() and np.isfinite(s.d).all() and np.isfinite(s.h).all():
+        ratios = run.quality.ratios(s.x, s.d, s.h)
+    folding = folding_diagnosis(ratios, run.mesh.x, run.mesh.conn) if ratios is not None else None
+    # a step above the critical one wrecks every shape too: then the step is named as well
+    step = _time_step_hint(run) if not folding or run.deck.solver.dt_safety_factor < 1 else ""
+    return (f"; {folding}" if folding else "") + step + step_history(run.dt_history)
+
+
+def _breaking_frame(run: Run, listener: Listener) -> None:
+    """The state the run broke down in, as a last frame, when it is still a shape (finite
+    positions); the frames before it are the last good ones."""
+    s = run.sim.state
+    if run.frame_times and run.frame_times[-1] == s.t or not np.isfinite(s.x).all():
+        return
+    with suppress(OutputError):  # the breakdown is the news; the summary still records it
+        _frame(run, listener)
+        run.breaking_frame = s.t
 
 
 def _time_step_hint(run: Run) -> str:
@@ -225,7 +249,8 @@ def _time_step_hint(run: Run) -> str:
 def integrate(run: Run, listener: Listener | None = None) -> Run:
     """Integrate the scene from t = 0 to the deck's end time.
 
-    Raises NumericalError when the run goes unstable (the samples recorded until then stay
+    Raises SceneTooLarge (status 'refused') when its steps would take longer than anyone
+    waits, before the first sample; NumericalError when the run goes unstable (the samples recorded until then stay
     in ``run``); KeyboardInterrupt passes through with ``run.status = 'interrupted'``.
     """
     listener = listener or Listener()
@@ -234,6 +259,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     start = time.perf_counter()
     try:
         _update_time_step(run, listener)
+        refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
         run.startup["first_dt_s"] = time.perf_counter() - start
         _record(run, listener)
         _frame(run, listener)
@@ -245,10 +271,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 step = equal_step(landing - sim.state.t, run.dt)
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
                 while sim.state.t < target:
-                    try:
-                        steps = sim.advance(target, step, solver.dt_update_every - since_update)
-                    except NumericalError as error:
-                        raise NumericalError(f"{error}{_time_step_hint(run)}") from None
+                    steps = sim.advance(target, step, solver.dt_update_every - since_update)
                     since_update += steps
                     if since_update >= solver.dt_update_every:
                         _update_time_step(run, listener)
@@ -258,27 +281,19 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 _check_stability(run)
             _frame(run, listener)
         run.status = "completed"
-    except NumericalError:
-        run.status = "unstable"
+    except SceneTooLarge:
+        run.status = "refused"
         raise
+    except NumericalError as error:
+        run.status = "unstable"
+        _breaking_frame(run, listener)
+        raise NumericalError(f"{error}{_breakdown_cause(run)}") from None
     except KeyboardInterrupt:
         run.status = "interrupted"
         raise
     finally:
         run.wall_time = time.perf_counter() - start
     return run
-
-
-def step_outlook(deck: Deck, model: Model) -> dict:
-    """What the run's time step will be, before it starts: the critical step at t = 0
-    [time] with each lumping, ``{"M1": .., "M2": ..}``, and ``steps``, the number of steps
-    to the end time with the deck's lumping and safety factor at that step (a stiffening
-    scene takes more)."""
-    critical = {mass: Simulation(model._replace(mass=mass)).critical_time_step() for mass in ("M1", "M2")}
-    dt = critical[deck.solver.mass] / deck.solver.dt_safety_factor
-    if deck.solver.dt_max is not None:
-        dt = min(dt, deck.solver.dt_max)
-    return critical | {"steps": math.ceil(deck.solver.end_time / dt)}
 
 
 def dt_statistics(run: Run) -> dict:

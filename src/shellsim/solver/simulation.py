@@ -3,6 +3,7 @@ in time. Holds arrays only; the time loop itself is compiled (:mod:`.explicit`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -92,9 +93,10 @@ class Simulation:
         point_tensors(s.x, s.d, s.h, conn, N, dNr, dNs, rule.tz, jac0_inv, s.stress[elements][:, points], *out)
         return tuple(out)
 
-    def critical_time_step(self) -> float:
-        """dt_critical = 2 / omega_max at the current state (warm-started Lanczos)."""
-        dt, self._eigenvector = critical_time_step(self, self._eigenvector)
+    def critical_time_step(self, on_product: Callable[[int], None] | None = None) -> float:
+        """dt_critical = 2 / omega_max at the current state (warm-started Lanczos);
+        ``on_product(count)`` hears of each stiffness product."""
+        dt, self._eigenvector = critical_time_step(self, self._eigenvector, on_product)
         return dt
 
     def evaluate_forces(self) -> None:

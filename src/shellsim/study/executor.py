@@ -15,6 +15,7 @@ import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
+from ..errors import StudyError
 from .jobs import Job, failed_row, run_job
 
 WARM_UP_DECK = """
@@ -58,29 +59,51 @@ def prepare_workers(client, local: bool) -> None:
     client.run(warm_numba_cache)
 
 
-def open_client(scheduler: str | None, workers: int | None = None):
+#: Seconds to wait for a scheduler to answer before saying it did not.
+CONNECT_TIMEOUT = 5.0
+
+
+def open_client(scheduler: str | None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
     """A dask client on ``scheduler`` (tcp://host:port), or on a new local cluster of
-    ``workers`` single-threaded processes (default: one per core)."""
+    ``workers`` single-threaded processes (default: one per core). Raises StudyError when
+    the scheduler does not answer within ``timeout`` seconds.
+
+    On the local cluster a job whose worker dies is not given to another worker (dask's
+    default tries three more, so one crashing job took four workers down): it becomes a
+    failed row naming the job."""
+    import dask
     from dask.distributed import Client
 
     if scheduler:
-        return Client(scheduler)
+        try:
+            return Client(scheduler, timeout=timeout)
+        except (OSError, TimeoutError, ValueError) as error:
+            raise StudyError(f"the dask scheduler at '{scheduler}' did not answer within {timeout:g} s "
+                             f"({type(error).__name__}: {error}); is it running, and is the address "
+                             "tcp://HOST:PORT?") from None
     # the client owns this cluster and shuts it down when closed
-    return Client(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
-                  dashboard_address=None)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        return Client(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+                      dashboard_address=None)
 
 
-def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None], threads: int | None = None) -> None:
+def run_jobs(jobs: list[Job], client, on_row: Callable[[dict], None], threads: int | None = None,
+             work: Callable[[Job, int | None], dict] | None = None) -> None:
     """Submit every job to ``client`` and call ``on_row`` with each row as it finishes;
-    ``threads``: the kernels' threads in each job (None: the worker's default)."""
-    from dask.distributed import as_completed
+    ``threads``: the kernels' threads in each job (None: the worker's default); ``work``
+    runs a job in a worker (default :func:`run_job_on_threads`)."""
+    from dask.distributed import KilledWorker, as_completed
 
-    futures = {client.submit(run_job_on_threads, job, threads, key=f"shellsim-{i}-{job.key}", pure=False): job
+    futures = {client.submit(work or run_job_on_threads, job, threads, key=f"shellsim-{i}-{job.key}", pure=False): job
                for i, job in enumerate(jobs)}
     for future in as_completed(futures):
         job = futures[future]
         if future.status == "error":
-            on_row(failed_row(job, future.exception()))
+            error = future.exception()
+            if isinstance(error, KilledWorker):
+                error = StudyError(f"the worker process running this job ({job.deck}, variant '{job.label}') died: "
+                                   f"a crash in compiled code or too little memory ({error})")
+            on_row(failed_row(job, error))
         else:
             on_row(future.result())
 

@@ -78,12 +78,17 @@ def variant_deck(path: Path, overrides: dict, label: str = "") -> Deck:
 
 
 def run_job(job: Job) -> dict:
-    """Run one job; returns its report row (raises on a broken deck or variant)."""
+    """Run one job; returns its report row, a failed one when the deck, the variant or its
+    files are broken. Nothing a job meets ends its worker: even a library's ``sys.exit``
+    becomes the row's message."""
     from ..execute import run_scene
     from ..output.folder import output_folder
 
-    scene = variant_deck(job.deck, job.overrides, job.label)
-    _, summary = run_scene(scene, job.deck, output_folder(job.folder))
+    try:
+        scene = variant_deck(job.deck, job.overrides, job.label)
+        _, summary = run_scene(scene, job.deck, output_folder(job.folder))
+    except (Exception, SystemExit) as error:
+        return failed_row(job, error)
     return row(job, summary)
 
 

@@ -1,0 +1,105 @@
+"""What a scene will cost before it runs: memory, the critical step, the number of steps
+and the wall time they take; a scene that cannot fit in memory or finish in a year is
+refused with the numbers that say why.
+
+The rates are measured on this project's reference machine (docs/verification.md,
+"Cost of a scene"): a run holds about 20 kB per element after a base of 0.4 GB (a
+90,000-element plate peaked at 1.9 GB), and one step of a group of 16 elements takes
+about 130 us on one thread.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from numba import get_num_threads
+
+from ..deck import Deck
+from ..element.lanes import group_count
+from ..errors import SceneTooLarge
+from ..model import Model
+from .simulation import Simulation
+
+BASE_BYTES, BYTES_PER_ELEMENT = 0.4e9, 20e3
+SECONDS_PER_GROUP_STEP = 130e-6
+#: A run longer than this is not one anybody will wait for: it is refused.
+HOPELESS_SECONDS = 365 * 24 * 3600.0
+
+
+def memory_bytes(n_elements: int) -> float:
+    """About how much memory a run of ``n_elements`` holds at its peak [bytes]."""
+    return BASE_BYTES + BYTES_PER_ELEMENT * n_elements
+
+
+def available_bytes() -> float | None:
+    """Memory available to a new process now [bytes] (Linux), or None where it cannot be read."""
+    try:
+        with open("/proc/meminfo") as info:
+            for line in info:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+def refuse_if_too_big(n_elements: int) -> None:
+    """Raise SceneTooLarge when the run would not fit in the memory available."""
+    need, have = memory_bytes(n_elements), available_bytes()
+    if have is not None and need > have:
+        raise SceneTooLarge(f"the mesh has {n_elements:,} elements: a run needs about {size_text(need)} of memory "
+                            f"and {size_text(have)} is available; coarsen [mesh] divisions or use a larger machine")
+
+
+def seconds_per_step(n_elements: int) -> float:
+    """About how long one explicit step takes on this machine's threads [s]."""
+    groups = group_count(n_elements)
+    return SECONDS_PER_GROUP_STEP * groups / min(groups, max(1, get_num_threads()))
+
+
+def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+    """What the run's time step will be, before it starts: the critical step at t = 0
+    [time] with each lumping, ``{"M1": .., "M2": ..}``; ``steps``, the number of steps to
+    the end time with the deck's lumping and safety factor at that step (a stiffening
+    scene takes more); ``seconds``, about how long they take, and ``bytes``, the memory the
+    run holds. ``on_product(count)`` is told each stiffness product of the estimates."""
+    critical = {mass: Simulation(model._replace(mass=mass)).critical_time_step(on_product)
+                for mass in ("M1", "M2")}
+    dt = critical[deck.solver.mass] / deck.solver.dt_safety_factor
+    if deck.solver.dt_max is not None:
+        dt = min(dt, deck.solver.dt_max)
+    steps = math.ceil(min(deck.solver.end_time / dt, 1e300))
+    return critical | {"dt": dt, "steps": steps, "seconds": steps * seconds_per_step(model.n_elements),
+                       "bytes": memory_bytes(model.n_elements)}
+
+
+def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:
+    """Raise SceneTooLarge when the steps of size ``dt`` to the end time would take longer
+    than HOPELESS_SECONDS."""
+    steps = deck.solver.end_time / dt
+    seconds = steps * seconds_per_step(n_elements)
+    if seconds > HOPELESS_SECONDS:
+        raise SceneTooLarge(
+            f"solver.end_time = {deck.solver.end_time:g} takes {steps:.3g} steps of {dt:.3g} (the critical step "
+            f"of the mesh's stiffest element, divided by solver.dt_safety_factor): about {duration(seconds)} on "
+            "this machine. Check the units of material.E, material.density and section.thickness against the "
+            "geometry and the end time; a thin shell's critical step falls with its thickness")
+
+
+def duration(seconds: float) -> str:
+    """'3.2 s', '14 min', '5.1 h', '2.3e+04 years'."""
+    if seconds < 120:
+        return f"{seconds:.2g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.2g} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.2g} h"
+    if seconds < 365 * 86400:
+        return f"{seconds / 86400:.2g} days"
+    return f"{seconds / (365 * 86400):.3g} years"
+
+
+def size_text(n_bytes: float) -> str:
+    """'1.9 GB', '420 MB'."""
+    return f"{n_bytes / 1e9:.2g} GB" if n_bytes >= 1e9 else f"{n_bytes / 1e6:.3g} MB"

@@ -1,0 +1,75 @@
+"""Element quality while a run goes, and what to say when it breaks down.
+
+An element's quality is the smallest ratio, over its Gauss points, of the Jacobian
+determinant of the shell body now to the one it had at the start: 1 for a rigid motion,
+falling as the element is crushed, 0 or below when it has folded over. Watched at every
+critical-step update (a few numpy products per element, nothing in the time loop), it
+tells a folding mesh from a time step that is too long.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import id_list, place
+from ..mesh import Mesh, body_jacobians
+
+#: Below this ratio an element is badly crushed, at or below 0 folded over.
+CRUSHED, FOLDED = 0.1, 0.0
+#: Critical-step updates looked back over in a breakdown's message.
+LOOK_BACK = 5
+
+
+@dataclass(frozen=True)
+class Worst:
+    """The worst element at time t: its index (from 0) and its Jacobian ratio."""
+
+    t: float
+    element: int
+    ratio: float
+
+
+class ElementQuality:
+    """Jacobian ratios of a mesh's elements, against the mesh as built."""
+
+    def __init__(self, mesh: Mesh):
+        self.conn = mesh.conn
+        self.initial = body_jacobians(mesh.x, mesh.conn, mesh.director, mesh.thickness)
+
+    def ratios(self, x: np.ndarray, director: np.ndarray, thickness: np.ndarray) -> np.ndarray:
+        """(ne,) smallest det J / det J0 over each element's Gauss points; shapes as the mesh's arrays."""
+        return (body_jacobians(x, self.conn, director, thickness) / self.initial).min(axis=(1, 2))
+
+    def worst(self, t: float, ratios: np.ndarray) -> Worst:
+        """The element with the smallest ratio (NaN counts as smallest: a state gone to pieces)."""
+        e = int(np.argmin(np.where(np.isnan(ratios), -np.inf, ratios)))
+        return Worst(t, e, float(ratios[e]))
+
+
+def folding_diagnosis(ratios: np.ndarray, x: np.ndarray, conn: np.ndarray) -> str | None:
+    """What a breakdown's message says of the mesh: the crushed or folded elements, the worst
+    first, with where it is (at its current place) and what to do; None when every element's
+    ratio is above CRUSHED. ratios (ne,), x (n, 3) current positions, conn (ne, 9)."""
+    ratios = np.where(np.isnan(ratios), -np.inf, ratios)
+    crushed = np.flatnonzero(ratios < CRUSHED)
+    if not crushed.size:
+        return None
+    crushed = crushed[np.argsort(ratios[crushed])]
+    worst = crushed[0]
+    state = "has folded over" if ratios[worst] <= FOLDED else "is crushed"
+    return (f"element {worst + 1} (counting from 1) at {place(x[conn[worst]].mean(axis=0))} {state}: its "
+            f"volume ratio det J / det J0 is {ratios[worst]:.3g}; {crushed.size} element(s) are below {CRUSHED:g} "
+            f"({id_list(crushed + 1)}). The mesh is too coarse there for this deformation, or the load comes "
+            "on too fast: refine the mesh around that element, or ramp the load more slowly")
+
+
+def step_history(dt_history: list[tuple[float, float, float]]) -> str:
+    """How the critical step moved over the last updates, for a breakdown's message."""
+    recent = dt_history[-LOOK_BACK:]
+    if len(recent) < 2:
+        return ""
+    (t0, c0, _), (t1, c1, _) = recent[0], recent[-1]
+    change = f"fell {c0 / c1:.3g} times" if c1 < c0 else f"went from {c0:.4g} to {c1:.4g}"
+    return f"; the critical step {change} between t = {t0:.6g} and t = {t1:.6g} ({c0:.4g} to {c1:.4g})"

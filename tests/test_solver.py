@@ -19,7 +19,7 @@ from shellsim.solver.explicit import EXTERNAL
 from shellsim.study.jobs import variant_deck
 from shellsim.verify.check import check, first_peak
 
-from .conftest import ROOT, prepared, run_deck
+from .conftest import ROOT, deck_text, prepared, run_deck
 
 PLATE = ROOT / "decks" / "verification" / "test01_plate_step_2x2.toml"
 
@@ -153,24 +153,7 @@ def test_reference_measures_and_tolerances():
     assert check(Reference(**ref | {"expected": 2.05}, measure="max", tolerance=0.1), t, values)["passed"]
 
 
-FOLDING = """
-[meta]
-title = "a corner driven through its element"
-
-[geometry]
-builder = "rectangle"
-length = 1.0
-width = 1.0
-
-[material]
-model = "linear_elastic"
-E = 1000.0
-nu = 0.3
-density = 1.0
-
-[section]
-thickness = 0.01
-
+FOLDING = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', """
 [[boundary]]
 type = "clamped"
 set = "x0"
@@ -192,10 +175,7 @@ curve = "ramp"
 [curves.ramp]
 t = [0.0, 1.0]
 value = [0.0, 1.0]
-
-[solver]
-end_time = 1.0
-"""
+""")
 
 
 def test_a_folding_element_is_named_as_the_cause_and_its_frame_kept(tmp_path):

@@ -93,18 +93,14 @@ def check(deck: DeckPath) -> None:
     """Validate a deck, build its mesh, summarise the scene, and say what its time step and
     step count will be."""
     from .deck import load_deck
-    from .geometry import build_mesh
+    from .execute import sized_mesh
     from .model import build_model
     from .plan import plan
-    from .solver.outlook import memory_bytes, refuse_if_hopeless, refuse_if_too_big, size_text, step_outlook
+    from .solver.outlook import refuse_if_hopeless, step_outlook
 
     scene = load_deck(deck)
-    with err.status("meshing") as status:
-        mesh = build_mesh(scene, deck.parent)
-        err.print(f"{mesh.n_elements:,} elements, {mesh.n_nodes:,} nodes: a run holds about "
-                  f"{size_text(memory_bytes(mesh.n_elements))}", highlight=False)
-        refuse_if_too_big(mesh.n_elements)
-        status.update("building the model")
+    mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{escape(text)}[/]", highlight=False))
+    with err.status("building the model") as status:
         model = build_model(scene, mesh)
         status.update("estimating the critical time step (the first use compiles the kernels, about two minutes)")
         outlook = step_outlook(scene, model, lambda count: status.update(

@@ -9,29 +9,41 @@ from pathlib import Path
 
 from . import __version__
 from .deck import Deck
+from .mesh import Mesh
 from .errors import NumericalError, OutputError, SceneTooLarge
 from .solver.run import Listener, Listeners, Run, Stopwatch, Timed
 
 
-def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = lambda text: None) -> Run:
-    """A run of ``scene`` ready to start (mesh, model, simulation; files named in the deck
-    are read relative to ``deck_folder``), with the seconds each took in ``run.startup``:
-    mesh_s, model_s, and kernels_s, the first masses and forces (the kernels compiled, or
-    loaded from numba's cache). :func:`shellsim.solver.run.integrate` adds first_dt_s.
-    ``announce`` hears each stage and the mesh's size. Raises SceneTooLarge for a mesh
+def _silent(text: str) -> None:
+    """An ``announce`` that tells nobody."""
+
+
+def sized_mesh(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = _silent) -> Mesh:
+    """The scene's mesh (files named in the deck read relative to ``deck_folder``), its size
+    and the memory a run of it holds told to ``announce``. Raises SceneTooLarge for a mesh
     that would not fit in memory."""
     from .geometry import build_mesh
-    from .model import build_model
     from .solver.outlook import memory_bytes, refuse_if_too_big, size_text
-    from .solver.run import prepare
 
-    clock = Stopwatch()
     announce("meshing")
     mesh = build_mesh(scene, deck_folder)
-    mesh_s = clock.lap()
     announce(f"{mesh.n_elements:,} elements, {mesh.n_nodes:,} nodes, {5 * mesh.n_nodes:,} DOFs: "
              f"about {size_text(memory_bytes(mesh.n_elements))} of memory")
     refuse_if_too_big(mesh.n_elements)
+    return mesh
+
+
+def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = _silent) -> Run:
+    """A run of ``scene`` ready to start (:func:`sized_mesh`, model, simulation), with the
+    seconds each took in ``run.startup``: mesh_s, model_s, and kernels_s, the first masses
+    and forces (the kernels compiled, or loaded from numba's cache).
+    :func:`shellsim.solver.run.integrate` adds first_dt_s. ``announce`` hears each stage."""
+    from .model import build_model
+    from .solver.run import prepare
+
+    clock = Stopwatch()
+    mesh = sized_mesh(scene, deck_folder, announce)
+    mesh_s = clock.lap()
     announce("building the model; then the kernels (compiled on first use, about two minutes)")
     model = build_model(scene, mesh)
     model_s = clock.lap()
@@ -41,7 +53,7 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
 
 
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
-              announce: Callable[[str], None] = lambda text: None) -> tuple[Run, dict]:
+              announce: Callable[[str], None] = _silent) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
     (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
     and summary.json whatever the end. Returns (run, summary); ``run.status`` tells how it

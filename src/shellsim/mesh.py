@@ -201,10 +201,15 @@ def check_mesh(mesh: Mesh, source: str, n_thick: int = 2) -> None:
     )
 
 
-def mid_surface_area(mesh: Mesh, n_gauss: int = 3) -> float:
-    """Area of the mid-surface by Gauss quadrature of |g_r x g_s|."""
+def element_areas(x: np.ndarray, conn: np.ndarray, n_gauss: int = 3) -> np.ndarray:
+    """Mid-surface area of each element by Gauss quadrature of |g_r x g_s|: x (n, 3), conn (ne, 9) -> (ne,)."""
     rs, w = gauss_rule_2d(n_gauss)
-    return float(np.einsum("eq,q->", np.linalg.norm(element_normals(mesh.x, mesh.conn, rs), axis=-1), w))
+    return np.einsum("eq,q->e", np.linalg.norm(element_normals(x, conn, rs), axis=-1), w)
+
+
+def mid_surface_area(mesh: Mesh, n_gauss: int = 3) -> float:
+    """Area of the mid-surface."""
+    return float(element_areas(mesh.x, mesh.conn, n_gauss).sum())
 
 
 def edges_within(conn: np.ndarray, nodes: np.ndarray) -> np.ndarray:

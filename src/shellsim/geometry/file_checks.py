@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..element.shape import gauss_rule_2d
 from ..errors import id_list, place
-from ..mesh import element_normals
+from ..mesh import element_areas
 
 #: How far a file's director may be from unit length and still be normalised silently.
 DIRECTOR_LENGTH_TOLERANCE = 1e-3
@@ -71,24 +70,13 @@ def point_data_problems(x: np.ndarray, director: np.ndarray | None, thickness: n
     return problems
 
 
-def collapsed_elements(x: np.ndarray, conn: np.ndarray) -> np.ndarray:
-    """Indices of elements whose mid-surface area is (numerically) zero: x (n, 3), conn (ne, 9)."""
-    rs, w = gauss_rule_2d(3)
-    area = np.einsum("eq,q->e", np.linalg.norm(element_normals(x, conn, rs), axis=-1), w)
-    corners = x[conn]
-    diameter = np.linalg.norm(corners.max(axis=1) - corners.min(axis=1), axis=1)
-    return np.flatnonzero(area <= COLLAPSED_AREA * diameter**2)
-
-
 def collapsed_problem(x: np.ndarray, conn: np.ndarray) -> list[str]:
-    """A message for elements of zero area, or none."""
-    bad = collapsed_elements(x, conn)
+    """Elements whose mid-surface area is (numerically) zero: x (n, 3), conn (ne, 9)."""
+    nodes = x[conn]
+    diameter = np.linalg.norm(nodes.max(axis=1) - nodes.min(axis=1), axis=1)
+    bad = np.flatnonzero(element_areas(x, conn) <= COLLAPSED_AREA * diameter**2)
     if not len(bad):
         return []
     return [f"{len(bad)} element(s) have zero area: elements {id_list(bad + 1)}, the first "
             f"at {place(x[conn[bad[0]]].mean(axis=0))}"]
 
-
-def normalised(director: np.ndarray) -> np.ndarray:
-    """Unit directors from ones already within the tolerance of unit length."""
-    return director / np.linalg.norm(director, axis=1, keepdims=True)

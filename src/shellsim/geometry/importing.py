@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import MeshError
 from ..mesh import NamedSet, edges_within
 from .file_checks import (
-    GMSH_QUAD9, collapsed_problem, missing_nodes_problem, normalised, point_data_problems, repeated_node_problem,
+    GMSH_QUAD9, collapsed_problem, missing_nodes_problem, point_data_problems, repeated_node_problem,
 )
 
 SET_PREFIX = "set_"
@@ -104,8 +104,8 @@ def read_mesh(path: Path) -> ImportedMesh:
     if not problems:
         problems = collapsed_problem(x, conn)
     _refuse(path, problems)
-    if director is not None:
-        director = normalised(director)
+    if director is not None:  # within the tolerance of unit length: made exactly unit
+        director = director / np.linalg.norm(director, axis=1, keepdims=True)
 
     sets: dict[str, NamedSet] = {}
     for name, per_block in m.cell_sets.items():

@@ -38,10 +38,9 @@ class ProgressDisplay(Listener):
         """At the first estimate: the step and what the run will cost."""
         if self.quiet or len(run.dt_history) != 1:
             return
-        from ..solver.outlook import duration, seconds_per_step
+        from ..solver.outlook import duration, stepping
 
-        steps = run.deck.solver.end_time / run.dt
-        cost = steps * seconds_per_step(run.model.n_elements)
+        steps, cost = stepping(run.deck.solver.end_time, run.dt, run.model.n_elements)
         self.announce(f"critical step {run.dt_critical:.4g}, step {run.dt:.4g}: about {steps:,.0f} steps, "
                       f"about {duration(cost)} of stepping ({duration(cost / run.deck.solver.end_time)} "
                       "per unit of simulated time)")

@@ -16,6 +16,7 @@ from collections.abc import Callable
 from numba import get_num_threads
 
 from ..deck import Deck
+from ..deck.schema import Solver
 from ..element.lanes import group_count
 from ..errors import SceneTooLarge
 from ..model import Model
@@ -58,6 +59,18 @@ def seconds_per_step(n_elements: int) -> float:
     return SECONDS_PER_GROUP_STEP * groups / min(groups, max(1, get_num_threads()))
 
 
+def stepping(end_time: float, dt: float, n_elements: int) -> tuple[float, float]:
+    """(steps, seconds): how many steps of ``dt`` reach ``end_time`` and about how long they take."""
+    steps = min(end_time / dt, 1e300)
+    return steps, steps * seconds_per_step(n_elements)
+
+
+def time_step(solver: Solver, dt_critical: float) -> float:
+    """The step a run takes at a critical step: divided by the safety factor, at most dt_max."""
+    dt = dt_critical / solver.dt_safety_factor
+    return dt if solver.dt_max is None else min(dt, solver.dt_max)
+
+
 def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What the run's time step will be, before it starts: the critical step at t = 0
     [time] with each lumping, ``{"M1": .., "M2": ..}``; ``steps``, the number of steps to
@@ -66,19 +79,16 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
     run holds. ``on_product(count)`` is told each stiffness product of the estimates."""
     critical = {mass: Simulation(model._replace(mass=mass)).critical_time_step(on_product)
                 for mass in ("M1", "M2")}
-    dt = critical[deck.solver.mass] / deck.solver.dt_safety_factor
-    if deck.solver.dt_max is not None:
-        dt = min(dt, deck.solver.dt_max)
-    steps = math.ceil(min(deck.solver.end_time / dt, 1e300))
-    return critical | {"dt": dt, "steps": steps, "seconds": steps * seconds_per_step(model.n_elements),
+    dt = time_step(deck.solver, critical[deck.solver.mass])
+    steps, seconds = stepping(deck.solver.end_time, dt, model.n_elements)
+    return critical | {"dt": dt, "steps": math.ceil(steps), "seconds": seconds,
                        "bytes": memory_bytes(model.n_elements)}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:
     """Raise SceneTooLarge when the steps of size ``dt`` to the end time would take longer
     than HOPELESS_SECONDS."""
-    steps = deck.solver.end_time / dt
-    seconds = steps * seconds_per_step(n_elements)
+    steps, seconds = stepping(deck.solver.end_time, dt, n_elements)
     if seconds > HOPELESS_SECONDS:
         raise SceneTooLarge(
             f"solver.end_time = {deck.solver.end_time:g} takes {steps:.3g} steps of {dt:.3g} (the critical step "

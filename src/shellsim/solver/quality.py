@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import id_list, place
-from ..mesh import Mesh, body_jacobians
+from ..mesh import Mesh, body_jacobians, jacobian_determinants
 
 #: Below this ratio an element is badly crushed, at or below 0 folded over.
 CRUSHED, FOLDED = 0.1, 0.0
@@ -36,23 +36,25 @@ class ElementQuality:
 
     def __init__(self, mesh: Mesh):
         self.conn = mesh.conn
-        self.initial = body_jacobians(mesh.x, mesh.conn, mesh.director, mesh.thickness)
+        self.initial = jacobian_determinants(mesh)
 
     def ratios(self, x: np.ndarray, director: np.ndarray, thickness: np.ndarray) -> np.ndarray:
-        """(ne,) smallest det J / det J0 over each element's Gauss points; shapes as the mesh's arrays."""
-        return (body_jacobians(x, self.conn, director, thickness) / self.initial).min(axis=(1, 2))
+        """(ne,) smallest det J / det J0 over each element's Gauss points, -inf where it is no
+        number (a state gone to pieces is the worst); shapes as the mesh's arrays."""
+        ratios = (body_jacobians(x, self.conn, director, thickness) / self.initial).min(axis=(1, 2))
+        return np.where(np.isnan(ratios), -np.inf, ratios)
 
     def worst(self, t: float, ratios: np.ndarray) -> Worst:
-        """The element with the smallest ratio (NaN counts as smallest: a state gone to pieces)."""
-        e = int(np.argmin(np.where(np.isnan(ratios), -np.inf, ratios)))
+        """The element with the smallest of ``ratios`` (ne,)."""
+        e = int(np.argmin(ratios))
         return Worst(t, e, float(ratios[e]))
 
 
 def folding_diagnosis(ratios: np.ndarray, x: np.ndarray, conn: np.ndarray) -> str | None:
     """What a breakdown's message says of the mesh: the crushed or folded elements, the worst
-    first, with where it is (at its current place) and what to do; None when every element's
-    ratio is above CRUSHED. ratios (ne,), x (n, 3) current positions, conn (ne, 9)."""
-    ratios = np.where(np.isnan(ratios), -np.inf, ratios)
+    first, with where it is and what to do; None when every element's ratio is above
+    CRUSHED. ratios (ne,) of :meth:`ElementQuality.ratios`, x (n, 3) the positions to place
+    it by (the mesh as built), conn (ne, 9)."""
     crushed = np.flatnonzero(ratios < CRUSHED)
     if not crushed.size:
         return None
@@ -71,5 +73,5 @@ def step_history(dt_history: list[tuple[float, float, float]]) -> str:
     if len(recent) < 2:
         return ""
     (t0, c0, _), (t1, c1, _) = recent[0], recent[-1]
-    change = f"fell {c0 / c1:.3g} times" if c1 < c0 else f"went from {c0:.4g} to {c1:.4g}"
-    return f"; the critical step {change} between t = {t0:.6g} and t = {t1:.6g} ({c0:.4g} to {c1:.4g})"
+    fall = f" ({c0 / c1:.3g} times smaller)" if c1 < c0 else ""
+    return f"; the critical step went from {c0:.4g} to {c1:.4g}{fall} between t = {t0:.6g} and t = {t1:.6g}"

@@ -24,7 +24,7 @@ from ..model import Model
 from ..output.probes import Probe, probe_value, resolve_probes
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
-from .outlook import refuse_if_hopeless
+from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
 
@@ -185,17 +185,14 @@ def _frame(run: Run, listener: Listener) -> None:
 
 
 def _update_time_step(run: Run, listener: Listener) -> None:
-    solver = run.deck.solver
     s = run.sim.state
     run.ratios = run.quality.ratios(s.x, s.d, s.h)
     run.worst = run.quality.worst(s.t, run.ratios)
-    if run.lowest is None or not run.worst.ratio >= run.lowest.ratio:
+    if run.lowest is None or run.worst.ratio < run.lowest.ratio:
         run.lowest = run.worst
     run.sim.update_masses()
     run.dt_critical = run.sim.critical_time_step()
-    run.dt = run.dt_critical / solver.dt_safety_factor
-    if solver.dt_max is not None:
-        run.dt = min(run.dt, solver.dt_max)
+    run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
     listener.on_dt(run)
 

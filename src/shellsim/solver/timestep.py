@@ -102,7 +102,7 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None,
 
 def _check_masses(mt: np.ndarray, mr: np.ndarray) -> None:
     """Lumped masses (n,) must be positive numbers for M^-1/2 K M^-1/2 to mean anything."""
-    bad = np.flatnonzero(~(mt > 0.0) | ~(mr > 0.0) | ~np.isfinite(mt) | ~np.isfinite(mr))
+    bad = np.flatnonzero(~((0.0 < mt) & (mt < np.inf) & (0.0 < mr) & (mr < np.inf)))  # NaN fails too
     if bad.size:
         raise NumericalError(
             f"the lumped masses of {bad.size} nodes (first, counting from 1: {(bad[:5] + 1).tolist()}) are not "

@@ -8,12 +8,14 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from shellsim.cli import app
+from shellsim.errors import MeshError
 from shellsim.geometry import build_mesh
+from shellsim.geometry.importing import read_mesh
 
 from .conftest import BASE
 
@@ -128,10 +130,35 @@ def test_any_combination_of_defects_names_those_found_first(tmp_path, defects, s
 def test_truncated_or_garbage_files_are_refused_with_a_message(tmp_path, suffix, kept, garbage):
     write_mesh(tmp_path / f"whole.{suffix}", [])
     whole = (tmp_path / f"whole.{suffix}").read_bytes()
-    (tmp_path / f"m.{suffix}").write_bytes(whole[: int(kept * len(whole))] + garbage)
+    cut = whole[: int(kept * len(whole))]
+    assume(garbage or not ends_a_whole_file(cut, whole))
+    (tmp_path / f"m.{suffix}").write_bytes(cut + garbage)
     result = check(deck_for(tmp_path, f"m.{suffix}"))
     assert result.exit_code == 2, result.output
     assert f"mesh file '{tmp_path / ('m.' + suffix)}'" in result.output.replace("\n", "")
+
+
+def ends_a_whole_file(cut: bytes, whole: bytes) -> bool:
+    """Whether ``cut``, the start of ``whole``, is itself a complete mesh file: it stops just
+    after a gmsh section (e.g. before the optional node data) or only a line end is missing."""
+    return re.search(rb"\n\$End\w+\n?$", cut) is not None or cut.rstrip() == whole.rstrip()
+
+
+@pytest.mark.parametrize("suffix", ["msh", "vtu"])
+def test_every_cut_of_a_mesh_file_is_refused_unless_it_is_complete(tmp_path, suffix):
+    """meshio reads on past a gmsh section cut short with only a warning; each of the file's
+    byte positions is tried."""
+    write_mesh(tmp_path / f"whole.{suffix}", [])
+    whole = (tmp_path / f"whole.{suffix}").read_bytes()
+    accepted = []
+    for end in range(1, len(whole)):
+        (tmp_path / f"m.{suffix}").write_bytes(whole[:end])
+        try:
+            read_mesh(tmp_path / f"m.{suffix}")
+            accepted.append(end)
+        except MeshError as err:
+            assert f"mesh file '{tmp_path / ('m.' + suffix)}'" in str(err)
+    assert all(ends_a_whole_file(whole[:end], whole) for end in accepted), accepted
 
 
 def test_a_triangle_mesh_is_refused_with_how_to_make_quad9(tmp_path):

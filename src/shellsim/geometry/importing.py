@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import re
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -61,7 +62,12 @@ def _read(path: Path):
         complaints = " ".join(line.strip() for line in said.getvalue().splitlines() if line.strip())
         reason = "; ".join(part for part in (complaints, str(err) if not isinstance(err, SystemExit) else "") if part)
         raise MeshError(f"mesh file '{path}' could not be read (truncated, or not a mesh?): {reason}") from None
-    sys.stderr.write(said.getvalue())
+    complaints = said.getvalue()
+    unclosed = re.search(r"\$(\w*) not closed", complaints)
+    if unclosed:  # meshio reads on past a cut-off section with only a warning
+        section = f"${unclosed.group(1)} section" if unclosed.group(1) else "last section"
+        raise MeshError(f"mesh file '{path}' is truncated: its {section} does not end")
+    sys.stderr.write(complaints)
     return mesh
 
 

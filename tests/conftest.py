@@ -56,10 +56,11 @@ def prepared(deck):
 
 
 def run_deck(deck):
-    """``deck`` run to its end time."""
+    """``deck`` run to its end time (or solved statically over it)."""
     from shellsim.solver.run import integrate
+    from shellsim.solver.static import solve_static
 
-    return integrate(prepared(deck))
+    return (solve_static if deck.solver.method == "static" else integrate)(prepared(deck))
 
 
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:

@@ -22,6 +22,7 @@ VERIFICATION = ROOT / "decks" / "verification"
 RUN = {
     "test01_nafems_21t_4x4.toml": {},
     "test02_cantilever_uniform_load_3.toml": {},
+    "test02_cantilever_uniform_load_3_static.toml": {},
     "test03_strip_moment_regular3.toml": {},
     "test03_strip_moment_irregular3_thick.toml": {},
     # Test 4 to 108 degrees on 6 square elements: with nu = 0 and loads per unit width the
@@ -29,11 +30,13 @@ RUN = {
     "test04_strip_rollup_M1.toml": {"geometry.width": 2.0, "mesh.points.tip": [12.0, 2.0, 0.0],
                                     "mesh.divisions.length": 6, "solver.end_time": 1.2},
     "test05_scordelis_lo_6x6.toml": {},
+    "test05_scordelis_lo_16x16_static.toml": {},
     "test06_twisted_beam_8_inplane.toml": {},
     "test06_twisted_beam_8_outofplane.toml": {},
     "test07_thick_cylinder_2x3_nu049.toml": {},
     "test07_thick_cylinder_2x3_nu04999.toml": {},
     "test09_aorta_slow_M1.toml": {},
+    "test09_aorta_static.toml": {},
     "test10_carotid_slow_M1.toml": {},
     "test10_carotid_slow_M2.toml": {},
 }

@@ -96,24 +96,29 @@ def check(deck: DeckPath) -> None:
     from .execute import sized_mesh
     from .model import build_model
     from .plan import plan
-    from .solver.outlook import refuse_if_hopeless, step_outlook
+    from .solver.outlook import refuse_if_hopeless, static_outlook, step_outlook
 
     scene = load_deck(deck)
     mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{escape(text)}[/]", highlight=False))
+    static = scene.solver.method == "static"
     with err.status("building the model") as status:
         model = build_model(scene, mesh)
-        status.update("estimating the critical time step (the first use compiles the kernels, about two minutes)")
-        outlook = step_outlook(scene, model, lambda count: status.update(
-            f"estimating the critical time step: {count} stiffness products"))
+        if static:
+            outlook = static_outlook(model)
+        else:
+            status.update("estimating the critical time step (the first use compiles the kernels, about two minutes)")
+            outlook = step_outlook(scene, model, lambda count: status.update(
+                f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
-    refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
-    if scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
+    if not static:
+        refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
+    if not static and scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(
             f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "
             "step: with M2 the rotary inertia of this thin shell sets the critical step (M1 floors it, "
             "thesis 3.14.1; on coarse meshes that slows bending: Test 1 on 2x2 peaks 7% late, docs/verification.md)"
         )
-    if scene.solver.dt_safety_factor < 1.0:
+    if not static and scene.solver.dt_safety_factor < 1.0:
         err.print(
             f"[yellow]warning:[/] solver.dt_safety_factor = {scene.solver.dt_safety_factor} < 1 "
             "puts the time step above the critical step: the run will be unstable"
@@ -191,7 +196,7 @@ def run(
         _deck_renders(scene, folder, quiet)
     if not quiet:
         out.print(_run_report(result, folder))
-    if current.status == "unstable":
+    if current.status in ("unstable", "not converged"):
         err.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
@@ -212,9 +217,12 @@ def _run_report(result: dict, folder: Path) -> Table | str:
     """The run's references as a table (or a line without them); the deck's texts are shown
     as written, never read as markup."""
     e = result["energy"]
-    caption = (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
-               f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
-               f"{e['balance_error_percent']:+.3f}%"
+    static = result.get("static")
+    caption = ((f"{static['load_steps']} load steps, {static['iterations']} Newton iterations, "
+                f"{static['cutbacks']} cut back, {result['wall_time_s']:.2f} s") if static else
+               (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
+                f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
+                f"{e['balance_error_percent']:+.3f}%")
                + (f", volume change {result['volume_change_percent']:+.3f}%" if "volume_change_percent" in result else "")
                + f"; results in {escape(str(folder))}")
     title = f"{escape(result['title'])}: {result['status']}"
@@ -428,14 +436,22 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
         curve = f" x curve '{load.curve}'" if load.curve else ""
         table.add_row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
     sv = scene.solver
-    table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
-                            f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
-                            + (f", damping {sv.damping}/s" if sv.damping else ""))
-    table.add_row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
-                               f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
-    table.add_row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
-                          f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
-                          f"{size_text(outlook['bytes'])} of memory")
+    if sv.method == "static":
+        st = sv.static
+        table.add_row("solver", f"static: Newton-Raphson load steps to t = {sv.end_time}, {st.increments} "
+                                f"first, at most {st.max_iterations} iterations each, tolerances force "
+                                f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")
+        table.add_row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
+                              f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
+    else:
+        table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
+                                f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
+                                + (f", damping {sv.damping}/s" if sv.damping else ""))
+        table.add_row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
+                                   f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
+        table.add_row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
+                              f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
+                              f"{size_text(outlook['bytes'])} of memory")
     for ref in scene.reference:
         tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
         table.add_row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "

@@ -67,6 +67,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .output.summary import summary, write_json
     from .plan import plan
     from .solver.run import integrate, output_times
+    from .solver.static import solve_static
 
     current = built_run(scene, deck_path.parent, announce)
     write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
@@ -77,7 +78,8 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
         check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
         writers = Timed(Listeners(history, frames))
         try:
-            integrate(current, Listeners(writers, progress or Listener()))
+            solve = solve_static if scene.solver.method == "static" else integrate
+            solve(current, Listeners(writers, progress or Listener()))
         except (NumericalError, SceneTooLarge) as error:
             message = str(error)
         except KeyboardInterrupt as stop:

@@ -15,6 +15,7 @@ import numpy as np
 
 from .bundles import (Body, Constraints, Curves, EdgePressureLoads, Loads, Material, Model, NodalLoads, Prescribed,
                       PressureLoads, Rule, Shape, slots_by_node)
+from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
 from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
@@ -258,18 +259,27 @@ def _orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarra
 
 
 def _curve_index(deck: Deck, name: str | None) -> int:
-    return -1 if name is None else list(deck.curves).index(name)
+    """The index of curve ``name`` in the tables; a load without one is constant (-1), or in
+    a static solve follows the ramp after the deck's curves (:func:`_curve_tables`)."""
+    if name is None:
+        return len(deck.curves) if deck.solver.method == "static" else -1
+    return list(deck.curves).index(name)
 
 
 def _curve_tables(deck: Deck, names: list[str]) -> Curves:
-    size = max([len(deck.curves[c].t) for c in names], default=1)
-    t = np.zeros((max(len(names), 1), size))
+    """The deck's curves as padded tables; a static solve appends the linear ramp from 0 at
+    t = 0 to 1 at the end time that its loads without a curve follow."""
+    tables = [deck.curves[name].table() for name in names]
+    if deck.solver.method == "static":
+        tables.append((np.array([0.0, deck.solver.end_time]), np.array([0.0, 1.0]), INTERPOLATION["linear"],
+                       EXTRAPOLATION["constant"]))
+    size = max([len(times) for times, *_ in tables], default=1)
+    t = np.zeros((max(len(tables), 1), size))
     v = np.zeros_like(t)
-    length = np.ones(max(len(names), 1), dtype=np.int64)
-    interp = np.zeros(max(len(names), 1), dtype=np.int64)
+    length = np.ones(max(len(tables), 1), dtype=np.int64)
+    interp = np.zeros(max(len(tables), 1), dtype=np.int64)
     extrap = np.zeros_like(interp)
-    for i, name in enumerate(names):
-        times, values, interp[i], extrap[i] = deck.curves[name].table()
+    for i, (times, values, interp[i], extrap[i]) in enumerate(tables):
         length[i] = len(times)
         t[i, :len(times)], v[i, :len(times)] = times, values
     return Curves(t=t, v=v, length=length, interp=interp, extrap=extrap)

@@ -67,12 +67,14 @@ def deck_reference() -> str:
     lines += ["## [[boundary]]", "", "Chosen by `type`.", ""]
     for cls in (schema.Clamped, schema.Fixed, schema.Symmetry, schema.Prescribed):
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
-    lines += ["## [[load]]", "", "Chosen by `type`; a load is `value * curve(t)`, constant without a curve.", ""]
+    lines += ["## [[load]]", "", "Chosen by `type`; a load is `value * curve(t)`, constant without a curve "
+              "(growing from 0 over a static solve).", ""]
     for cls in (schema.Pressure, schema.EdgeForce, schema.EdgePressure, schema.EdgeMoment,
                 schema.PointForce, schema.PointMoment, schema.BodyForce):
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")
+    lines += _table(schema.Static, "### [solver.static]")
     lines += _table(schema.Output, "## [output]")
     lines += _table(schema.Probe, "## [[output.probe]]")
     lines += _table(schema.Render, "## [[output.render]]")

@@ -216,14 +216,38 @@ Load = Annotated[
 ]
 
 
+class Static(Section):
+    """``[solver.static]``: the Newton-Raphson load steps of ``method = "static"``.
+
+    The pseudo-time runs from 0 to ``solver.end_time``; the loads follow their curves in it,
+    and a load or prescribed motion without a curve grows linearly from 0 to its value over
+    it. ``increments``: load steps to try first (more are taken where Newton needs them:
+    a step that does not converge in ``max_iterations`` is cut to a quarter, one that
+    converges in a few iterations grows by half, down to ``min_increment`` of the span).
+    An iteration has converged when the residual force is within ``force_tolerance`` of
+    the largest of the external and internal force norms and the residual's work on the
+    correction within ``energy_tolerance`` of the step's first."""
+
+    increments: Count = 1
+    max_iterations: Count = 16
+    force_tolerance: Positive = 1e-6
+    energy_tolerance: Positive = 1e-12
+    min_increment: Positive = 1e-6
+
+
 class Solver(Section):
-    """``[solver]``: central differences from t = 0 to ``end_time``.
+    """``[solver]``: central differences from t = 0 to ``end_time`` (``method =
+    "explicit"``, the default), or static equilibrium by Newton-Raphson load steps over
+    the pseudo-time 0 to ``end_time`` (``method = "static"``, settings in
+    ``[solver.static]``).
 
     Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
     inverse), Δt_critical re-estimated every ``dt_update_every`` steps. ``mass``: lumped M1
     (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
     coefficient in 1/s (0 = undamped, the default)."""
 
+    method: Literal["explicit", "static"] = "explicit"
+    static: Static = Static()
     end_time: Positive
     dt_safety_factor: Positive = 1.25
     dt_update_every: Count = 100

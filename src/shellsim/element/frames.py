@@ -75,6 +75,14 @@ def rotate_director(d: np.ndarray, e1: np.ndarray, dtheta1: float, dtheta2: floa
 
 
 @njit(cache=True, error_model="numpy")
+def rotate_directors(d, e1, nodes, dtheta):
+    """:func:`rotate_director` at each of ``nodes`` (k,) by the increments dtheta (k, 2);
+    d, e1 (n, 3) in place."""
+    for k in range(nodes.shape[0]):
+        rotate_director(d[nodes[k]], e1[nodes[k]], dtheta[k, 0], dtheta[k, 1])
+
+
+@njit(cache=True, error_model="numpy")
 def to_rotational(g, d, e1, out):
     """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
     (-e1f.g, -e2f.g), e2f = d x e1f."""

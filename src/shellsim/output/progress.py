@@ -46,6 +46,11 @@ class ProgressDisplay(Listener):
                       "per unit of simulated time)")
 
     def _fields(self, run: Run) -> dict:
+        if run.newton:  # a static solve: its last load step in place of the time step
+            step = run.newton[-1]
+            return {"t": f"{run.sim.state.t:.4g}", "dt": f"load step {len(run.newton)}", "rate": "-",
+                    "balance": f"{step.iterations} iterations, residual {step.residual:.2g}",
+                    "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
         elapsed = max(time.perf_counter() - self.started, 1e-9)
         e = run.sim.state.energy
         scale = max(abs(e[2]), 1e-300)
@@ -61,9 +66,10 @@ class ProgressDisplay(Listener):
             self.bar.update(self.task, completed=run.sim.state.t, **self._fields(run))
         elif run.sim.state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
             f = self._fields(run)
-            self.console.print(f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
-                               f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}, worst J/J0 {f['quality']}",
-                               highlight=False)
+            done = f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
+            self.console.print(done + (f"{f['dt']}: {f['balance']}" if run.newton else
+                                       f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}, "
+                                       f"worst J/J0 {f['quality']}"), highlight=False)
             self.next_line += 0.1
 
     def close(self) -> None:

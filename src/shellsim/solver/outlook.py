@@ -85,6 +85,17 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
                        "bytes": memory_bytes(model.n_elements)}
 
 
+#: One element's tangent by central differences takes about six group evaluations.
+GROUP_EVALUATIONS_PER_TANGENT = 6
+
+
+def static_outlook(model: Model) -> dict:
+    """What a static solve will hold and cost per tangent: ``unknowns`` (5 DOF per node,
+    supports' included), ``seconds`` per tangent on this machine's threads, ``bytes``."""
+    seconds = GROUP_EVALUATIONS_PER_TANGENT * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
+    return {"unknowns": 5 * model.n_nodes, "seconds": seconds, "bytes": memory_bytes(model.n_elements)}
+
+
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:
     """Raise SceneTooLarge when the steps of size ``dt`` to the end time would take longer
     than HOPELESS_SECONDS."""

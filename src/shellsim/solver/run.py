@@ -58,6 +58,7 @@ class Run:
     worst: Worst | None = None  # the worst element at the last step update
     lowest: Worst | None = None  # the worst element seen over the run
     breaking_frame: float | None = None  # time of the frame written as the run broke down
+    newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
 
     @property
     def balance_error(self) -> float:

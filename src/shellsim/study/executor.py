@@ -40,15 +40,25 @@ fields = ["displacement", "cauchy_stress", "pressure_band"]
 """
 
 
+#: The static solve's kernels (element and follower-pressure tangents) on the same scene.
+WARM_UP_STATIC = WARM_UP_DECK.replace("end_time = 1e-3", 'method = "static"\nend_time = 1e-3') + """
+[[load]]
+type = "pressure"
+set = "all"
+value = 1e-3
+"""
+
+
 def warm_numba_cache() -> None:
     """Compile every kernel a run uses, here, once, so workers only load the cache."""
     from ..deck import parse_deck
     from ..execute import run_scene
 
-    with tempfile.TemporaryDirectory() as folder:
-        deck = Path(folder) / "warm_up.toml"
-        deck.write_text(WARM_UP_DECK)
-        run_scene(parse_deck(WARM_UP_DECK), deck, Path(folder))
+    for text in (WARM_UP_DECK, WARM_UP_STATIC):
+        with tempfile.TemporaryDirectory() as folder:
+            deck = Path(folder) / "warm_up.toml"
+            deck.write_text(text)
+            run_scene(parse_deck(text), deck, Path(folder))
 
 
 def prepare_workers(client, local: bool) -> None:

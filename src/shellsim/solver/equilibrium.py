@@ -1,0 +1,186 @@
+"""Static equilibrium of a simulation's state: the residual force over the unknowns, the
+tangent stiffness assembled sparse, and the state moved by a correction.
+
+The residual is what the time loop computes, f_ext(t) - f_int, for every formulation,
+material and load (fibre-length update included), taken over the unknowns of
+:mod:`.unknowns`. The tangent is the sum of the elements' own (:mod:`shellsim.element.tangent`),
+less the derivative of the follower pressures and of the dead moments, which turn with
+the shell. The incremental formulations measure their strain from the last converged
+state, so every evaluation starts from its stresses and fibre lengths.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..element.frames import rotate_directors
+from ..element.stress_update import INCREMENTAL, TOTAL
+from ..element.tangent import ELEMENT_DOFS, element_tangents
+from ..compiled_call import TypedCall
+from ..curve_tables import factor
+from ..loads.pressure import pressure_tangents
+from . import explicit
+from .simulation import Simulation
+from .unknowns import SLOTS, unknowns
+
+#: Difference steps of the tangent: a share of the mean element size, and radians.
+STEP_SHARE, STEP_ROTATION = 1e-6, 1e-6
+
+
+class Converged:
+    """A copy of the state's shape, rotations and stresses, to go back to."""
+
+    def __init__(self, sim: Simulation):
+        s = sim.state
+        self.t = s.t
+        self.arrays = {name: getattr(s, name).copy() for name in ("x", "d", "e1", "h", "theta", "stress")}
+
+    def restore(self, sim: Simulation) -> None:
+        for name, values in self.arrays.items():
+            getattr(sim.state, name)[:] = values
+        sim.state.t = self.t
+
+
+class Equilibrium:
+    """Residual, tangent and corrections of ``sim``'s state (a :class:`Simulation`)."""
+
+    def __init__(self, sim: Simulation):
+        self.sim = sim
+        model = sim.model
+        self.unknowns = unknowns(model)
+        self.mode = INCREMENTAL if model.material.incremental else TOTAL
+        self.converged = Converged(sim)
+        conn = model.conn
+        size = np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1))
+        self.step_u = STEP_SHARE * size
+        self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
+        self.pressure_k = np.zeros((len(model.loads.pressure.elements), ELEMENT_DOFS, ELEMENT_DOFS))
+        self.moment_nodes = np.flatnonzero(np.abs(model.loads.moment.vectors).sum(axis=(0, 2)) > 0)
+        self._tangents = TypedCall(element_tangents)
+        self._pressure_tangents = TypedCall(pressure_tangents)
+        self._forces = TypedCall(explicit.forces)
+        self._pattern()
+
+    def _pattern(self) -> None:
+        """The sparse structure of the tangent's free rows and all columns, and where each
+        element entry goes in it."""
+        u = self.unknowns
+        model = self.sim.model
+        dofs = u.index[model.conn].reshape(len(model.conn), ELEMENT_DOFS)  # (ne, 45)
+        rows = np.broadcast_to(dofs[:, :, None], self.element_k.shape).ravel()
+        cols = np.broadcast_to(dofs[:, None, :], self.element_k.shape).ravel()
+        used = (rows >= 0) & (rows < u.n_free) & (cols >= 0)
+        self._entries = np.flatnonzero(used)
+        keys = cols[used] * u.n_free + rows[used]  # column-major: sorted keys are CSC order
+        unique, self._slot = np.unique(keys, return_inverse=True)
+        indices = (unique % u.n_free).astype(np.int32)
+        counts = np.bincount(unique // u.n_free, minlength=u.size)
+        indptr = np.zeros(u.size + 1, dtype=np.int32)
+        np.cumsum(counts, out=indptr[1:])
+        self._csc = (indices, indptr, len(unique))
+        # each node's frame as a (5, 5) block: the translations turned, the rotations kept
+        blocks = np.zeros((model.n_nodes, SLOTS, SLOTS))
+        blocks[:, :3, :3] = u.frames
+        blocks[:, 3, 3] = blocks[:, 4, 4] = 1.0
+        self._turned = not np.allclose(u.frames, np.eye(3))
+        self._element_blocks = blocks[model.conn]  # (ne, 9, 5, 5)
+
+    # --- the state -------------------------------------------------------------------
+    def evaluate(self, t: float) -> None:
+        """Internal and external forces at the state's shape and load time t, the
+        incremental formulations from the converged state."""
+        s, space = self.sim.state, self.sim.workspace
+        if self.mode == INCREMENTAL:
+            c = self.converged.arrays
+            np.subtract(s.x, c["x"], out=space.dx)
+            np.subtract(s.d, c["d"], out=space.dd)
+            s.stress[:] = c["stress"]
+            s.h[:] = c["h"]
+        self._forces(float(t), self.sim.model, s.fields, space)
+
+    def residual(self) -> np.ndarray:
+        """f_ext - f_int over the unknowns (size,) from the last :meth:`evaluate`."""
+        s = self.sim.state
+        return self.unknowns.gather(self.unknowns.to_local(s.f_ext - s.f_int, s.fr_ext - s.fr_int))
+
+    def force_scale(self) -> float:
+        """The larger of the external and internal force norms over every DOF (supports'
+        included, so that a displacement-driven scene has a scale)."""
+        s = self.sim.state
+        ext = np.sqrt(np.sum(s.f_ext**2) + np.sum(s.fr_ext**2))
+        internal = np.sqrt(np.sum(s.f_int**2) + np.sum(s.fr_int**2))
+        return float(max(ext, internal))
+
+    def move(self, correction: np.ndarray) -> None:
+        """Add a correction (size,) of the unknowns to the state: translations along the
+        nodes' frames, rotations of the directors."""
+        s = self.sim.state
+        local = self.unknowns.scatter(correction)
+        s.x += np.einsum("nij,nj->ni", self.unknowns.frames, local[:, :3])
+        nodes = np.flatnonzero(np.any(local[:, 3:] != 0.0, axis=1))
+        rotate_directors(s.d, s.e1, nodes, np.ascontiguousarray(local[nodes, 3:]))
+        s.theta += local[:, 3:]
+
+    def prescribed_increments(self, t: float) -> np.ndarray:
+        """(n_known,) the moves that bring the prescribed translations to their values at t."""
+        model, s = self.sim.model, self.sim.state
+        p = model.constraints.prescribed
+        targets = np.array([model.x0[n, a] + v * factor(model.curves, c, t)
+                            for n, a, v, c in zip(p.nodes, p.axes, p.values, p.curves)])
+        return targets - s.x[p.nodes, p.axes] if len(p.nodes) else np.zeros(0)
+
+    # --- the tangent -----------------------------------------------------------------
+    def tangent(self, t: float) -> sp.csc_matrix:
+        """K (n_free, size) = d(f_int - f_ext)/du at the state and load time t: the free
+        rows, the free columns first, then the prescribed ones."""
+        model, s, space = self.sim.model, self.sim.state, self.sim.workspace
+        c = self.converged.arrays
+        shape = s.fields.shape
+        if self.mode == INCREMENTAL:  # the increments are measured with the converged lengths
+            shape = shape._replace(h=c["h"])
+        self._tangents(np.int64(self.mode), model.rule, model.body, model.material, shape, space.dx, space.dd,
+                       c["stress"], self.step_u, STEP_ROTATION, self.element_k)
+        k = self.element_k
+        pressure = model.loads.pressure
+        if len(pressure.elements):
+            scale = np.array([v * factor(model.curves, cv, t) for v, cv in zip(pressure.value, pressure.curve)])
+            self._pressure_tangents(model.rule, model.conn, s.fields.shape, pressure, scale, self.step_u,
+                                    STEP_ROTATION, self.pressure_k)
+            k = k.copy()
+            np.subtract.at(k, pressure.elements, self.pressure_k)
+        if len(self.moment_nodes):
+            k = k if k is not self.element_k else k.copy()
+            self._add_moment_stiffness(t, k)
+        if self._turned:
+            blocks = self._element_blocks
+            k = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k.reshape(len(k), 9, SLOTS, 9, SLOTS), blocks,
+                          optimize=True).reshape(k.shape)
+        indices, indptr, nnz = self._csc
+        data = np.bincount(self._slot, weights=k.ravel()[self._entries], minlength=nnz)
+        return sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
+
+    def _add_moment_stiffness(self, t: float, k: np.ndarray) -> None:
+        """Less the derivative of the dead moments' rotational forces (-e_j . (M x d)) with
+        respect to the node's rotations, central differences, into the diagonal block of
+        the node in its first element."""
+        model, s = self.sim.model, self.sim.state
+        nodes = self.moment_nodes
+        moments = np.zeros((len(nodes), 3))
+        for vectors, curve in zip(model.loads.moment.vectors, model.loads.moment.curve):
+            moments += factor(model.curves, curve, t) * vectors[nodes]
+        block = np.zeros((len(nodes), 2, 2))
+        for j in range(2):
+            for sign in (1.0, -1.0):
+                d, e1 = s.d.copy(), s.e1.copy()
+                turn = np.zeros((len(nodes), 2))
+                turn[:, j] = sign * STEP_ROTATION
+                rotate_directors(d, e1, nodes, turn)
+                dn, e1n = d[nodes], e1[nodes]
+                g = np.cross(moments, dn)
+                fr = -np.stack([np.sum(e1n * g, axis=1), np.sum(np.cross(dn, e1n) * g, axis=1)], axis=1)
+                block[:, :, j] -= sign * fr / (2 * STEP_ROTATION)
+        first = np.array([np.argmax((model.conn == n).any(axis=1)) for n in nodes])
+        local = np.array([int(np.flatnonzero(model.conn[e] == n)[0]) for e, n in zip(first, nodes)])
+        for m, (e, a) in enumerate(zip(first, local)):
+            k[e, 5 * a + 3:5 * a + 5, 5 * a + 3:5 * a + 5] += block[m]

@@ -1,0 +1,183 @@
+"""Static equilibrium by Newton-Raphson load steps (``solver.method = "static"``): the
+pseudo-time runs from 0 to the end time, the loads follow their curves in it, and each
+step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`.
+
+Step control: a step that does not converge in ``max_iterations`` (or whose residual
+turns to no number, or whose tangent is singular) is taken again from the last converged
+state at a quarter of its length; one that converges within GROWTH_ITERATIONS iterations
+lets the next grow by half, up to the deck's first length. The outputs are the explicit
+run's: a history sample at every converged step, frames at the output times.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+
+from ..errors import NumericalError, SceneTooLarge
+from .equilibrium import Converged, Equilibrium
+from .quality import folding_diagnosis
+from .run import Listener, Run, _breaking_frame, _frame, _record, output_times
+
+CUT, GROW, GROWTH_ITERATIONS = 0.25, 1.5, 4
+
+
+@dataclass
+class NewtonStep:
+    """A converged load step: its end t, the iterations it took, the relative residual it
+    ended with, and the tries cut back before it converged."""
+
+    t: float
+    iterations: int
+    residual: float
+    cutbacks: int
+
+
+class NotConverged(Exception):
+    """A load step that could not be solved: why, and at which iteration."""
+
+
+def _factorised(tangent):
+    """The sparse LU factors of ``tangent`` (square)."""
+    try:
+        lu = spla.splu(tangent, permc_spec="COLAMD")
+    except RuntimeError as error:  # "Factor is exactly singular"
+        raise NotConverged(f"the tangent stiffness is singular ({error})") from None
+    return lu
+
+
+class NewtonSolver:
+    """Load steps of a run (:class:`shellsim.solver.run.Run`) to equilibrium."""
+
+    def __init__(self, run: Run):
+        self.run = run
+        self.settings = run.deck.solver.static
+        self.eq = Equilibrium(run.sim)
+        self.n_free = self.eq.unknowns.n_free
+        self.last_residual = np.zeros(self.n_free)
+
+    def step(self, t: float) -> tuple[int, float]:
+        """Equilibrium at load time t from the converged state; returns (iterations,
+        relative residual). Raises NotConverged with the reason."""
+        eq, settings, n_free = self.eq, self.settings, self.n_free
+        eq.evaluate(t)
+        residual = eq.residual()[:n_free]
+        known = eq.prescribed_increments(t)
+        first_energy = None
+        lu = None
+        for iteration in range(settings.max_iterations + 1):
+            scale = eq.force_scale()
+            if not np.all(np.isfinite(residual)):
+                raise NotConverged("the residual is no longer a number")
+            norm = float(np.linalg.norm(residual))
+            if iteration == 0 and not np.any(known) and norm <= settings.force_tolerance * scale:
+                return 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
+            if iteration > 0:
+                # the energy of the next correction, with the last factorisation
+                energy = abs(float(lu.solve(residual) @ residual))
+                if norm <= settings.force_tolerance * scale and energy <= settings.energy_tolerance * first_energy:
+                    self.last_residual = residual
+                    return iteration, norm / max(scale, 1e-300)
+            if iteration == settings.max_iterations:
+                self.last_residual = residual
+                raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
+                                   "of the force scale")
+            tangent = eq.tangent(t)
+            lu = _factorised(tangent[:, :n_free])
+            rhs = residual - tangent[:, n_free:] @ known if iteration == 0 and len(known) else residual
+            correction = lu.solve(rhs)
+            if first_energy is None:
+                first_energy = max(abs(float(correction @ rhs)), 1e-300)
+            eq.move(np.concatenate([correction, known if iteration == 0 else np.zeros_like(known)]))
+            eq.evaluate(t)
+            residual = eq.residual()[:n_free]
+        raise AssertionError("unreachable")
+
+    def commit(self) -> None:
+        """The state is converged: steps now start from it."""
+        self.eq.converged = Converged(self.run.sim)
+
+
+def solve_static(run: Run, listener: Listener | None = None) -> Run:
+    """Solve the scene statically from t = 0 to the deck's end time, sampling the history
+    at every converged step and writing frames at the output times.
+
+    Raises NumericalError (status 'not converged') naming the load time, the residual and
+    the worst place when a step cannot be solved even cut to ``min_increment``; the
+    samples and frames until then are kept. KeyboardInterrupt passes through with
+    ``run.status = 'interrupted'``.
+    """
+    listener = listener or Listener()
+    settings = run.deck.solver.static
+    end = run.deck.solver.end_time
+    sim = run.sim
+    start = time.perf_counter()
+    try:
+        newton = NewtonSolver(run)
+        run.startup["first_dt_s"] = 0.0
+        _record(run, listener)
+        _frame(run, listener)
+        largest = end / settings.increments
+        length = largest
+        for landing in output_times(run.deck):
+            while sim.state.t < landing - 1e-12 * end:
+                cutbacks = 0
+                while True:
+                    remaining = landing - sim.state.t
+                    # the step lands on the output time when it is near (no sliver of a step left)
+                    target = landing if remaining <= 1.25 * length else sim.state.t + length
+                    try:
+                        iterations, residual = newton.step(target)
+                        break
+                    except NotConverged as why:
+                        newton.eq.converged.restore(sim)
+                        cutbacks += 1
+                        length = min(length, remaining) * CUT
+                        if length < settings.min_increment * end:
+                            raise NumericalError(_not_converged(run, newton, target, str(why))) from None
+                sim.state.t = target
+                sim.state.steps += 1
+                newton.commit()
+                run.newton.append(NewtonStep(t=target, iterations=iterations, residual=residual, cutbacks=cutbacks))
+                _record(run, listener)
+                if iterations <= GROWTH_ITERATIONS and cutbacks == 0:
+                    length = min(length * GROW, largest)
+            _frame(run, listener)
+        run.status = "completed"
+    except SceneTooLarge:
+        run.status = "refused"
+        raise
+    except NumericalError:
+        run.status = "not converged"
+        _breaking_frame(run, listener)  # the last converged state
+        raise
+    except KeyboardInterrupt:
+        run.status = "interrupted"
+        raise
+    finally:
+        run.wall_time = time.perf_counter() - start
+    return run
+
+
+def _not_converged(run: Run, newton: NewtonSolver, target: float, why: str) -> str:
+    """The message of a step that cannot be solved: where in the load, why, the node with
+    the largest residual force and its place, and any folded element."""
+    end = run.deck.solver.end_time
+    s = run.sim.state
+    message = (f"the static solve did not converge on the way from t = {s.t:.6g} to t = {target:.6g} "
+               f"({100 * target / end:.3g}% of solver.end_time) even in steps of "
+               f"{run.deck.solver.static.min_increment:g} of it: {why}")
+    local = newton.eq.unknowns.scatter(np.concatenate([newton.last_residual, np.zeros(newton.eq.unknowns.n_known)]))
+    per_node = np.linalg.norm(local, axis=1)
+    if per_node.max() > 0:
+        node = int(np.argmax(per_node))
+        x = run.mesh.x[node]
+        message += f"; the largest residual force is at node {node + 1} ({x[0]:.4g}, {x[1]:.4g}, {x[2]:.4g})"
+    folding = folding_diagnosis(run.quality.ratios(s.x, s.d, s.h), run.mesh.x, run.mesh.conn)
+    if folding:
+        message += f"; {folding}"
+    return message + ". A smaller solver.static.increments start, a load that stops short of a limit point, " \
+                     "or the explicit method past it may help"

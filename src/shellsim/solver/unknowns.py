@@ -1,0 +1,86 @@
+"""The unknowns of a static solve: the 5 DOF per node with the supports eliminated.
+
+Each node's translations are taken in a frame of its own (its columns: the directions its
+supports leave free, then its prescribed axes, then the fixed rest), so a symmetry plane
+at any angle removes exactly one unknown. Rotations are the two fibre-frame increments of
+:func:`shellsim.element.frames.rotate_director`, each free or fixed.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..bundles import Model
+
+#: Columns of a node's row in :attr:`Unknowns.index`: three translations in the node's
+#: frame, then the two rotations.
+SLOTS = 5
+
+
+@dataclass(frozen=True)
+class Unknowns:
+    """frames (n, 3, 3): each node's translation directions as columns; index (n, 5): the
+    number of each node DOF among the unknowns, free ones 0..n_free-1, prescribed ones
+    n_free..n_free+n_known-1 (in the order of ``model.constraints.prescribed``), -1 fixed."""
+
+    frames: np.ndarray
+    index: np.ndarray
+    n_free: int
+    n_known: int
+
+    @property
+    def size(self) -> int:
+        return self.n_free + self.n_known
+
+    def to_local(self, f: np.ndarray, fr: np.ndarray) -> np.ndarray:
+        """Nodal forces f (n, 3) and fr (n, 2) as (n, 5) in the nodes' frames."""
+        return np.concatenate([np.einsum("nij,ni->nj", self.frames, f), fr], axis=1)
+
+    def gather(self, local: np.ndarray) -> np.ndarray:
+        """The unknowns' entries (size,) of a nodal (n, 5) array."""
+        out = np.zeros(self.size)
+        used = self.index >= 0
+        out[self.index[used]] = local[used]
+        return out
+
+    def scatter(self, values: np.ndarray) -> np.ndarray:
+        """A nodal (n, 5) array from the unknowns' values (size,), 0 where fixed."""
+        local = np.zeros(self.index.shape)
+        used = self.index >= 0
+        local[used] = values[self.index[used]]
+        return local
+
+
+def unknowns(model: Model) -> Unknowns:
+    """The :class:`Unknowns` of ``model``'s supports."""
+    n = model.n_nodes
+    constraints = model.constraints
+    prescribed_axes: list[list[tuple[int, int]]] = [[] for _ in range(n)]
+    for p, (node, axis) in enumerate(zip(constraints.prescribed.nodes, constraints.prescribed.axes)):
+        prescribed_axes[node].append((p, axis))
+    frames = np.empty((n, 3, 3))
+    index = np.full((n, SLOTS), -1, dtype=np.int64)
+    n_free = 0
+    for node in range(n):
+        values, vectors = np.linalg.eigh(constraints.projector[node])
+        free = list(vectors[:, values > 0.5].T)
+        moved = [np.eye(3)[axis] for _, axis in prescribed_axes[node]]
+        columns = free + moved
+        for axis in np.eye(3):  # complete the frame with the fixed directions
+            rest = axis - sum(((c @ axis) * c for c in columns), np.zeros(3))
+            if len(columns) < 3 and np.linalg.norm(rest) > 1e-6:
+                columns.append(rest / np.linalg.norm(rest))
+        frames[node] = np.asarray(columns).T
+        for k in range(len(free)):
+            index[node, k] = n_free
+            n_free += 1
+        for j in range(2):
+            if constraints.rot_free[node, j] > 0.5:
+                index[node, 3 + j] = n_free
+                n_free += 1
+    for node in range(n):
+        for k, (p, _) in enumerate(prescribed_axes[node]):
+            index[node, (index[node, :3] >= 0).sum() + k] = n_free + p
+    return Unknowns(frames=frames, index=index, n_free=n_free, n_known=len(constraints.prescribed.nodes))

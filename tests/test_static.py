@@ -1,0 +1,198 @@
+"""The static solver: its tangent against differences of the residual along random
+directions (every material path, distorted curved elements, a follower pressure and a
+moment), against the stiffness product at rest, Newton's quadratic convergence, and a
+step that cannot converge stopped with a message that says where."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.deck import parse_deck
+from shellsim.element.assembly import stiffness_product
+from shellsim.geometry import build_mesh
+from shellsim.model import build_model
+from shellsim.solver.equilibrium import Converged, Equilibrium
+from shellsim.solver.run import prepare
+from shellsim.solver.static import NewtonSolver
+
+from .conftest import ROOT, deck_text
+
+PANEL = """builder = "cylindrical_panel"
+radius = 2.0
+length = 1.0
+angle_deg = 40.0
+"""
+
+SUPPORTS = """
+[mesh]
+divisions = { around = 2, along = 2 }
+
+[[boundary]]
+type = "clamped"
+set = "y0"
+
+[[boundary]]
+type = "symmetry"
+set = "phi0"
+normal = [1.0, 0.0, 0.0]
+
+[[load]]
+type = "pressure"
+set = "all"
+value = PRESSURE
+face = "top"
+
+[[load]]
+type = "point_moment"
+set = "phi1_y1"
+value = [0.0, MOMENT, 0.0]
+"""
+STATIC = '[solver]\nmethod = "static"\nend_time = 1.0'
+
+
+#: The fibre lengths held: the tangent leaves out how a node's length follows the stretch
+#: of its elements (a coupling beyond the element, through the loads on the faces).
+HELD = "thickness_update = false"
+#: (material table, section table, pressure, moment): every constitutive path.
+PATHS = {
+    "small strain, total": ('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0', "", 0.02, 0.01),
+    "small strain, incremental": ('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0',
+                                  'formulation = "incremental"', 0.02, 0.01),
+    "St. Venant-Kirchhoff (technique 1)": ('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0',
+                                           f"technique = 1\n{HELD}", 0.02, 0.01),
+    "technique 2": ('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0', f"technique = 2\n{HELD}", 0.02,
+                    0.01),
+    "technique 3": ('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0', f"technique = 3\n{HELD}", 0.02,
+                    0.01),
+    "neo-Hookean": ('model = "neo_hookean"\nC1 = 200.0\ndensity = 1.0', HELD, 0.02, 0.01),
+    "Mooney-Rivlin": ('model = "mooney_rivlin"\nC1 = 150.0\nC2 = 50.0\ndensity = 1.0', HELD, 0.02, 0.01),
+    "Guccione": ('model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\ndensity = 1.0\n'
+                 'axes = { kind = "cylindrical", axis = [0.0, 1.0, 0.0] }', HELD, 0.02, 0.01),
+}
+
+
+def panel_run(material: str, section: str, pressure: float, moment: float, distort: bool = True):
+    """A run of a 2 x 2 curved panel, clamped on one curved edge and symmetric on a
+    straight one, its interior nodes moved off their places (distorted elements)."""
+    text = deck_text(PANEL, SUPPORTS.replace("PRESSURE", repr(pressure)).replace("MOMENT", repr(moment)))
+    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0', material)
+    text = text.replace("thickness = 0.01", "thickness = 0.05\n" + section).replace("[solver]\nend_time = 1.0", STATIC)
+    deck = parse_deck(text)
+    mesh = build_mesh(deck)
+    if distort:
+        rng = np.random.default_rng(1)
+        inner = np.setdiff1d(np.arange(mesh.n_nodes), np.concatenate([s.nodes for s in mesh.sets.values()
+                                                                      if s.kind == "edge"]))
+        mesh.x[inner] += 0.04 * rng.standard_normal((len(inner), 3)) * [1, 1, 0.2]
+    return prepare(deck, mesh, build_model(deck, mesh))
+
+
+def residual_after(eq: Equilibrium, move: np.ndarray, t: float) -> np.ndarray:
+    """The free residual with the state moved by ``move`` (then moved back)."""
+    saved = Converged(eq.sim)
+    eq.move(move)
+    eq.evaluate(t)
+    r = eq.residual()[:eq.unknowns.n_free].copy()
+    saved.restore(eq.sim)
+    return r
+
+
+@pytest.mark.parametrize(("path", "limit"), [(path, 1e-6) for path in PATHS] + [
+    (path + ", lengths following", 1e-6) for path in ("technique 2", "Guccione")])
+def test_tangent_matches_differences_of_the_residual(path, limit):
+    """K v against central differences of the residual along random directions v (all
+    unknowns at once, rotations included), at a strained state away from equilibrium: to
+    1e-6 with the fibre lengths held (measured 3e-10 to 9e-9), and with them following
+    the stretch, the coupling the tangent leaves out (measured 2e-8 and 9e-7)."""
+    material, section, pressure, moment = PATHS[path.removesuffix(", lengths following")]
+    run = panel_run(material, section if "following" not in path else section.replace(HELD, ""), pressure, moment)
+    eq = Equilibrium(run.sim)
+    rng = np.random.default_rng(7)
+    size = eq.unknowns.size
+    # a strained state: random moves of about a thickness and 0.1 rad from the converged one
+    strain = rng.standard_normal(size) * np.where(_is_rotation(eq), 0.1, 0.03)
+    eq.move(strain)
+    t = 1.0
+    eq.evaluate(t)
+    k = eq.tangent(t).toarray()
+    for _ in range(3):
+        v = rng.standard_normal(size) * np.where(_is_rotation(eq), 1.0, 0.3)
+        h = 1e-6
+        derivative = (residual_after(eq, h * v, t) - residual_after(eq, -h * v, t)) / (2 * h)
+        error = np.linalg.norm(k @ v + derivative) / np.linalg.norm(derivative)
+        assert error <= limit, (path, error)
+
+
+def _is_rotation(eq: Equilibrium) -> np.ndarray:
+    """(size,) True for the unknowns that are rotations."""
+    kind = np.zeros(eq.unknowns.size, dtype=bool)
+    index = eq.unknowns.index
+    kind[index[:, 3:][index[:, 3:] >= 0]] = True
+    return kind
+
+
+@pytest.mark.parametrize("path", ["small strain, total", "neo-Hookean", "Guccione"])
+def test_tangent_at_rest_is_the_stiffness_product(path):
+    """At the undeformed, unstressed state the tangent is the material stiffness K_L that
+    the critical-step estimate's product applies (no load: no load stiffness)."""
+    material, section, _, _ = PATHS[path]
+    run = panel_run(material, section, 0.0, 0.0)
+    eq = Equilibrium(run.sim)
+    eq.evaluate(0.0)
+    k = eq.tangent(0.0).toarray()
+    model, s = run.model, run.sim.state
+    rng = np.random.default_rng(3)
+    v = rng.standard_normal(eq.unknowns.size)
+    local = eq.unknowns.scatter(v)
+    vu = np.einsum("nij,nj->ni", eq.unknowns.frames, local[:, :3])
+    f, fr = np.zeros_like(vu), np.zeros((model.n_nodes, 2))
+    stiffness_product(model.rule, model.body, model.material, s.fields.shape, s.stress, vu,
+                      np.ascontiguousarray(local[:, 3:]), f, fr, run.sim.workspace.parts)
+    product = eq.unknowns.gather(eq.unknowns.to_local(f, fr))[:eq.unknowns.n_free]
+    assert np.linalg.norm(k @ v - product) <= 1e-6 * np.linalg.norm(product)
+
+
+def test_newton_converges_quadratically():
+    """A curved panel under a pressure and a moment large enough to turn it well out of
+    the linear range, in one load step: once near, each iteration squares the residual."""
+    run = panel_run(*PATHS["neo-Hookean"][:2], 0.01, 0.003, distort=False)  # 0.5 rad, 2 thicknesses
+    newton = NewtonSolver(run)
+    norms = []
+    eq = newton.eq
+    original = eq.residual
+    eq.residual = lambda: _recorded(original(), norms, eq)
+    newton.step(1.0)
+    rates = [np.log(b) / np.log(a) for a, b in zip(norms, norms[1:]) if 1e-13 < b < a < 1e-2]
+    assert len(norms) >= 4 and rates, norms
+    assert min(rates) >= 1.7, (norms, rates)
+
+
+def _recorded(residual, norms, eq):
+    norms.append(np.linalg.norm(residual[:eq.unknowns.n_free]) / max(eq.force_scale(), 1e-300))
+    return residual
+
+
+def test_a_step_that_cannot_converge_is_stopped_with_where(tmp_path):
+    """A neo-Hookean tube (Test 9's) inflated far beyond its limit pressure, where no
+    equilibrium exists: load control cannot pass the limit point, so the steps are cut
+    back to the smallest and the run stops with exit code 3, the load time, the residual
+    and the node, the samples before it kept."""
+    text = (ROOT / "decks" / "verification" / "test09_aorta_static.toml").read_text()
+    text = re.sub(r"\[material\]\n[^\[]*\[[^\]]*\] }\n", '[material]\nmodel = "neo_hookean"\nC1 = 1.0e4\ndensity = 1050.0\n',
+                  text)
+    text = text.replace("value = 18.66e3", "value = 10.0e3").replace(
+        'end_time = 0.16\n', 'end_time = 0.16\nstatic = { increments = 4, min_increment = 0.01, max_iterations = 10 }\n')
+    text = text[:text.index("[[reference]]")]
+    deck = tmp_path / "burst.toml"
+    deck.write_text(text)
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 3, result.output
+    said = " ".join(result.output.split())
+    assert "did not converge" in said and "% of solver.end_time" in said and "largest residual force is at node" in said
+    history = (tmp_path / "out" / "history.csv").read_text().splitlines()
+    assert len(history) >= 3  # the header, t = 0 and the steps before the limit point

@@ -228,11 +228,11 @@ def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarra
     rot_free = np.ones((n, 2))
     e1f0 = np.empty((n, 3))
     for node in range(n):
-        basis = _orthonormal(constrained[node])
+        basis = orthonormal(constrained[node])
         projector[node] = np.eye(3) - sum((np.outer(b, b) for b in basis), np.zeros((3, 3)))
         d = mesh.director[node]
         initial_fibre_frame(d, e1f0[node])
-        in_plane = _orthonormal([p - (p @ d) * d for p in planes[node]])
+        in_plane = orthonormal([p - (p @ d) * d for p in planes[node]])
         if director_fixed[node] or len(in_plane) >= 2:
             rot_free[node] = 0.0
         elif len(in_plane) == 1:
@@ -247,7 +247,7 @@ def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarra
     return Constraints(projector=projector, rot_free=rot_free, prescribed=moved), e1f0
 
 
-def _orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarray]:
+def orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarray]:
     """Gram-Schmidt basis of the span of ``vectors`` (dependent ones dropped)."""
     basis: list[np.ndarray] = []
     for v in vectors:

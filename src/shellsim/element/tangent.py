@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from .frames import cross, rotate_director
-from .lanes import LANES, gather_element_values
+from .lanes import LANES, gather_element_values, gather_nodal_scalars
 from .response import group_response, group_scratch
 from .stress_update import INCREMENTAL
 
@@ -25,6 +25,8 @@ from .stress_update import INCREMENTAL
 ELEMENT_DOFS = 45
 #: Lanes per element: each DOF moved forward and back.
 _MOVES = 2 * ELEMENT_DOFS
+#: Group evaluations per element tangent.
+BATCHES = -(-_MOVES // LANES)
 
 
 @njit(cache=True, error_model="numpy")
@@ -61,58 +63,67 @@ def element_tangents(mode, rule, body, material, shape, dx, dd, stress, step_u, 
 
 @njit(cache=True, error_model="numpy")
 def _element_tangent(e, mode, rule, body, material, shape, dx, dd, stress, step_u, step_r, ke):
-    """ke (45, 45) of element e; arguments as :func:`element_tangents`."""
+    """ke (45, 45) of element e; arguments as :func:`element_tangents`. Every lane holds
+    the element as it is; each batch moves one node of each lane and puts it back after."""
     conn = body.conn
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
     work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
     hyper = material.technique == 1
-    lengths = body.h0 if hyper else shape.h
     members = work.members
     members[:] = e
+    gather_nodal_scalars(conn, members, body.h0 if hyper else shape.h, work.he)
     gather_element_values(body.jac0_inv, members, work.jac0)
     if hyper:
         gather_element_values(material.axes0, members, work.axes0)
     if mode == INCREMENTAL:
         gather_element_values(stress, members, work.stress)
         base_stress = work.stress.copy()
+    frames = np.empty((9, 2, 3, LANES))  # each lane's fibre axes e1, e2 at its nodes
+    for a in range(9):
+        node = conn[e, a]
+        _place_node(work, frames, a, -1, shape.x[node], shape.d[node], shape.e1[node], dx[node], dd[node])
     xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
     steps = np.zeros(LANES)
-    frames = np.empty((9, 2, 3, LANES))  # each lane's fibre axes e1, e2 at its nodes
     ke[:] = 0.0
-    for batch in range(-(-_MOVES // LANES)):
+    for batch in range(BATCHES):
         for lane in range(LANES):
             move = min(batch * LANES + lane, _MOVES - 1)
-            node_moved = move // 10
-            for a in range(9):
-                node = conn[e, a]
-                if a == node_moved:
-                    steps[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r,
-                                             xm, dm, e1m)
-                else:
-                    xm[:] = shape.x[node]
-                    dm[:] = shape.d[node]
-                    e1m[:] = shape.e1[node]
-                for i in range(3):
-                    work.xe[a, i, lane] = xm[i]
-                    work.de[a, i, lane] = dm[i]
-                    work.ue[a, i, lane] = dx[node, i] + xm[i] - shape.x[node, i]
-                    work.ve[a, i, lane] = dd[node, i] + dm[i] - shape.d[node, i]
-                    frames[a, 0, i, lane] = e1m[i]
-                frames[a, 1, 0, lane], frames[a, 1, 1, lane], frames[a, 1, 2, lane] = cross(dm, e1m)
-                work.he[a, lane] = lengths[node]
+            node = conn[e, move // 10]
+            steps[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r, xm, dm,
+                                     e1m)
+            _place_node(work, frames, move // 10, lane, xm, dm, e1m, dx[node] + xm - shape.x[node],
+                        dd[node] + dm - shape.d[node])
         if mode == INCREMENTAL:
             work.stress[:] = base_stress
         group_response(mode, rule, material, work, LANES)
         for lane in range(LANES):
-            move = batch * LANES + lane
-            if move >= _MOVES:
-                break
-            column = move // 2
-            weight = 1.0 / (2.0 * steps[lane])  # + f / 2h forward, - f / 2h back (steps[lane] = -h)
-            for a in range(9):
-                for i in range(3):
-                    ke[5 * a + i, column] += weight * work.fe[a, i, lane]
-                for j in range(2):
-                    ke[5 * a + 3 + j, column] -= weight * (frames[a, j, 0, lane] * work.ge[a, 0, lane]
-                                                           + frames[a, j, 1, lane] * work.ge[a, 1, lane]
-                                                           + frames[a, j, 2, lane] * work.ge[a, 2, lane])
+            move = min(batch * LANES + lane, _MOVES - 1)
+            if batch * LANES + lane < _MOVES:
+                column = move // 2
+                weight = 1.0 / (2.0 * steps[lane])  # + f / 2h forward, - f / 2h back (steps[lane] = -h)
+                for a in range(9):
+                    for i in range(3):
+                        ke[5 * a + i, column] += weight * work.fe[a, i, lane]
+                    for j in range(2):  # in the moved frames
+                        ke[5 * a + 3 + j, column] -= weight * (frames[a, j, 0, lane] * work.ge[a, 0, lane]
+                                                               + frames[a, j, 1, lane] * work.ge[a, 1, lane]
+                                                               + frames[a, j, 2, lane] * work.ge[a, 2, lane])
+            node = conn[e, move // 10]
+            _place_node(work, frames, move // 10, lane, shape.x[node], shape.d[node], shape.e1[node], dx[node],
+                        dd[node])
+
+
+@njit(cache=True, inline="always")
+def _place_node(work, frames, a, lane, x, d, e1, u, v):
+    """Node a of lane ``lane`` (every lane when -1) at position x, director d, fibre axis
+    e1 (3,), with increments u, v (3,) from the converged state."""
+    first, stop = (0, LANES) if lane < 0 else (lane, lane + 1)
+    e2 = cross(d, e1)
+    for k in range(first, stop):
+        for i in range(3):
+            work.xe[a, i, k] = x[i]
+            work.de[a, i, k] = d[i]
+            work.ue[a, i, k] = u[i]
+            work.ve[a, i, k] = v[i]
+            frames[a, 0, i, k] = e1[i]
+            frames[a, 1, i, k] = e2[i]

@@ -73,20 +73,18 @@ def pressure_tangents(rule, conn, shape, faces, scale, step_u, step_r, k):
     :mod:`shellsim.element.tangent`; the fibre lengths held)."""
     xe, de, he, e1e = np.empty((9, 3)), np.empty((9, 3)), np.empty(9), np.empty((9, 3))
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
-    xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
     for m in range(faces.elements.shape[0]):
         nodes = conn[faces.elements[m]]
+        for a in range(9):
+            xe[a] = shape.x[nodes[a]]
+            de[a] = shape.d[nodes[a]]
+            e1e[a] = shape.e1[nodes[a]]
+            he[a] = shape.h[nodes[a]]
         k[m] = 0.0
         for move in range(2 * ELEMENT_DOFS):
-            moved = move // 10
-            for a in range(9):
-                xe[a] = shape.x[nodes[a]]
-                de[a] = shape.d[nodes[a]]
-                e1e[a] = shape.e1[nodes[a]]
-                he[a] = shape.h[nodes[a]]
-            step = moved_node(shape.x[nodes[moved]], shape.d[nodes[moved]], shape.e1[nodes[moved]], move % 10, step_u,
-                              step_r, xm, dm, e1m)
-            xe[moved], de[moved], e1e[moved] = xm, dm, e1m
+            moved, node = move // 10, nodes[move // 10]
+            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r, xe[moved],
+                              de[moved], e1e[moved])
             fe[:] = 0.0
             ge[:] = 0.0
             face_forces(rule, xe, de, he, faces.face[m], scale[m], fe, ge)
@@ -98,3 +96,6 @@ def pressure_tangents(rule, conn, shape, faces, scale, step_u, step_r, k):
                     k[m, 5 * a + i, column] += weight * fe[a, i]
                     k[m, 5 * a + 3, column] -= weight * e1e[a, i] * ge[a, i]
                     k[m, 5 * a + 4, column] -= weight * e2[i] * ge[a, i]
+            xe[moved] = shape.x[node]  # the node back in place
+            de[moved] = shape.d[node]
+            e1e[moved] = shape.e1[node]

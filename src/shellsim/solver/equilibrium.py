@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..element.frames import rotate_directors
+from ..element.frames import rotate_directors, to_rotational
 from ..element.stress_update import INCREMENTAL, TOTAL
 from ..element.tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
@@ -57,6 +57,9 @@ class Equilibrium:
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self.pressure_k = np.zeros((len(model.loads.pressure.elements), ELEMENT_DOFS, ELEMENT_DOFS))
         self.moment_nodes = np.flatnonzero(np.abs(model.loads.moment.vectors).sum(axis=(0, 2)) > 0)
+        # each moment node's first slot e * 9 + a: its diagonal block in element e takes the moment's stiffness
+        self._moment_slots = model.body.slots[model.body.node_slots[self.moment_nodes]]
+        self._t = 0.0
         self._tangents = TypedCall(element_tangents)
         self._pressure_tangents = TypedCall(pressure_tangents)
         self._forces = TypedCall(explicit.forces)
@@ -90,6 +93,7 @@ class Equilibrium:
     def evaluate(self, t: float) -> None:
         """Internal and external forces at the state's shape and load time t, the
         incremental formulations from the converged state."""
+        self._t = t
         s, space = self.sim.state, self.sim.workspace
         if self.mode == INCREMENTAL:
             c = self.converged.arrays
@@ -131,27 +135,25 @@ class Equilibrium:
         return targets - s.x[p.nodes, p.axes] if len(p.nodes) else np.zeros(0)
 
     # --- the tangent -----------------------------------------------------------------
-    def tangent(self, t: float) -> sp.csc_matrix:
-        """K (n_free, size) = d(f_int - f_ext)/du at the state and load time t: the free
-        rows, the free columns first, then the prescribed ones."""
+    def tangent(self) -> sp.csc_matrix:
+        """K (n_free, size) = d(f_int - f_ext)/du at the state and load time of the last
+        :meth:`evaluate` (its increments and pressures): the free rows, the free columns
+        first, then the prescribed ones."""
         model, s, space = self.sim.model, self.sim.state, self.sim.workspace
         c = self.converged.arrays
         shape = s.fields.shape
         if self.mode == INCREMENTAL:  # the increments are measured with the converged lengths
             shape = shape._replace(h=c["h"])
+        k = self.element_k  # every element's block is overwritten: the loads' are added in place
         self._tangents(np.int64(self.mode), model.rule, model.body, model.material, shape, space.dx, space.dd,
-                       c["stress"], self.step_u, STEP_ROTATION, self.element_k)
-        k = self.element_k
+                       c["stress"], self.step_u, STEP_ROTATION, k)
         pressure = model.loads.pressure
         if len(pressure.elements):
-            scale = np.array([v * factor(model.curves, cv, t) for v, cv in zip(pressure.value, pressure.curve)])
-            self._pressure_tangents(model.rule, model.conn, s.fields.shape, pressure, scale, self.step_u,
-                                    STEP_ROTATION, self.pressure_k)
-            k = k.copy()
+            self._pressure_tangents(model.rule, model.conn, s.fields.shape, pressure, space.scale_pressure,
+                                    self.step_u, STEP_ROTATION, self.pressure_k)
             np.subtract.at(k, pressure.elements, self.pressure_k)
         if len(self.moment_nodes):
-            k = k if k is not self.element_k else k.copy()
-            self._add_moment_stiffness(t, k)
+            self._add_moment_stiffness(k)
         if self._turned:
             blocks = self._element_blocks
             k = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k.reshape(len(k), 9, SLOTS, 9, SLOTS), blocks,
@@ -160,27 +162,25 @@ class Equilibrium:
         data = np.bincount(self._slot, weights=k.ravel()[self._entries], minlength=nnz)
         return sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
 
-    def _add_moment_stiffness(self, t: float, k: np.ndarray) -> None:
-        """Less the derivative of the dead moments' rotational forces (-e_j . (M x d)) with
-        respect to the node's rotations, central differences, into the diagonal block of
-        the node in its first element."""
+    def _add_moment_stiffness(self, k: np.ndarray) -> None:
+        """Less the derivative of the dead moments' rotational forces with respect to the
+        node's rotations, central differences, into the node's diagonal block in its first
+        element."""
         model, s = self.sim.model, self.sim.state
         nodes = self.moment_nodes
         moments = np.zeros((len(nodes), 3))
         for vectors, curve in zip(model.loads.moment.vectors, model.loads.moment.curve):
-            moments += factor(model.curves, curve, t) * vectors[nodes]
+            moments += factor(model.curves, curve, self._t) * vectors[nodes]
         block = np.zeros((len(nodes), 2, 2))
+        fr = np.empty((len(nodes), 2))
         for j in range(2):
             for sign in (1.0, -1.0):
-                d, e1 = s.d.copy(), s.e1.copy()
+                d, e1 = s.d[nodes], s.e1[nodes]
                 turn = np.zeros((len(nodes), 2))
                 turn[:, j] = sign * STEP_ROTATION
-                rotate_directors(d, e1, nodes, turn)
-                dn, e1n = d[nodes], e1[nodes]
-                g = np.cross(moments, dn)
-                fr = -np.stack([np.sum(e1n * g, axis=1), np.sum(np.cross(dn, e1n) * g, axis=1)], axis=1)
+                rotate_directors(d, e1, np.arange(len(nodes)), turn)
+                to_rotational(np.cross(moments, d), d, e1, fr)  # the moment's director force M x d
                 block[:, :, j] -= sign * fr / (2 * STEP_ROTATION)
-        first = np.array([np.argmax((model.conn == n).any(axis=1)) for n in nodes])
-        local = np.array([int(np.flatnonzero(model.conn[e] == n)[0]) for e, n in zip(first, nodes)])
-        for m, (e, a) in enumerate(zip(first, local)):
-            k[e, 5 * a + 3:5 * a + 5, 5 * a + 3:5 * a + 5] += block[m]
+        for slot, b in zip(self._moment_slots, block):
+            e, a = divmod(int(slot), 9)
+            k[e, 5 * a + 3:5 * a + 5, 5 * a + 3:5 * a + 5] += b

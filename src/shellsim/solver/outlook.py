@@ -18,6 +18,7 @@ from numba import get_num_threads
 from ..deck import Deck
 from ..deck.schema import Solver
 from ..element.lanes import group_count
+from ..element.tangent import BATCHES
 from ..errors import SceneTooLarge
 from ..model import Model
 from .simulation import Simulation
@@ -85,14 +86,11 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
                        "bytes": memory_bytes(model.n_elements)}
 
 
-#: One element's tangent by central differences takes about six group evaluations.
-GROUP_EVALUATIONS_PER_TANGENT = 6
-
-
 def static_outlook(model: Model) -> dict:
     """What a static solve will hold and cost per tangent: ``unknowns`` (5 DOF per node,
     supports' included), ``seconds`` per tangent on this machine's threads, ``bytes``."""
-    seconds = GROUP_EVALUATIONS_PER_TANGENT * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
+    # an element's tangent takes BATCHES evaluations of a group
+    seconds = BATCHES * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
     return {"unknowns": 5 * model.n_nodes, "seconds": seconds, "bytes": memory_bytes(model.n_elements)}
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import signal
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 
@@ -254,8 +254,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     listener = listener or Listener()
     solver = run.deck.solver
     sim = run.sim
-    start = time.perf_counter()
-    try:
+    with ending(run, listener, "unstable", _breakdown_cause) as start:
         _update_time_step(run, listener)
         refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
         run.startup["first_dt_s"] = time.perf_counter() - start
@@ -278,20 +277,31 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 _record(run, listener)
                 _check_stability(run)
             _frame(run, listener)
+    return run
+
+
+@contextmanager
+def ending(run: Run, listener: Listener, broken: str, cause: Callable[[Run], str] = lambda run: "") -> Iterator[float]:
+    """The block solves ``run`` (yielding its start time): its status as it ends
+    ('completed'; 'refused', SceneTooLarge; ``broken``, NumericalError, whose message gains
+    ``cause(run)`` after the breaking state is kept as a frame; 'interrupted',
+    KeyboardInterrupt, each raised on) and its wall time, however it ends."""
+    start = time.perf_counter()
+    try:
+        yield start
         run.status = "completed"
     except SceneTooLarge:
         run.status = "refused"
         raise
     except NumericalError as error:
-        run.status = "unstable"
+        run.status = broken
         _breaking_frame(run, listener)
-        raise NumericalError(f"{error}{_breakdown_cause(run)}") from None
+        raise NumericalError(f"{error}{cause(run)}") from None
     except KeyboardInterrupt:
         run.status = "interrupted"
         raise
     finally:
         run.wall_time = time.perf_counter() - start
-    return run
 
 
 def dt_statistics(run: Run) -> dict:

@@ -11,16 +11,15 @@ run's: a history sample at every converged step, frames at the output times.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..errors import NumericalError, SceneTooLarge
+from ..errors import NumericalError
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
-from .run import Listener, Run, _breaking_frame, _frame, _record, output_times
+from .run import Listener, Run, _frame, _record, ending, output_times
 
 CUT, GROW, GROWTH_ITERATIONS = 0.25, 1.5, 4
 
@@ -37,7 +36,7 @@ class NewtonStep:
 
 
 class NotConverged(Exception):
-    """A load step that could not be solved: why, and at which iteration."""
+    """A load step that could not be solved, and why."""
 
 
 def _factorised(tangent):
@@ -72,6 +71,7 @@ class NewtonSolver:
             scale = eq.force_scale()
             if not np.all(np.isfinite(residual)):
                 raise NotConverged("the residual is no longer a number")
+            self.last_residual = residual  # the last one that was a number, for a message
             norm = float(np.linalg.norm(residual))
             if iteration == 0 and not np.any(known) and norm <= settings.force_tolerance * scale:
                 return 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
@@ -79,13 +79,11 @@ class NewtonSolver:
                 # the energy of the next correction, with the last factorisation
                 energy = abs(float(lu.solve(residual) @ residual))
                 if norm <= settings.force_tolerance * scale and energy <= settings.energy_tolerance * first_energy:
-                    self.last_residual = residual
                     return iteration, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
-                self.last_residual = residual
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale")
-            tangent = eq.tangent(t)
+            tangent = eq.tangent()
             lu = _factorised(tangent[:, :n_free])
             rhs = residual - tangent[:, n_free:] @ known if iteration == 0 and len(known) else residual
             correction = lu.solve(rhs)
@@ -95,6 +93,26 @@ class NewtonSolver:
             eq.evaluate(t)
             residual = eq.residual()[:n_free]
         raise AssertionError("unreachable")
+
+    def reach(self, landing: float, length: float) -> tuple[NewtonStep, float]:
+        """A converged step from the state's t toward ``landing``, tried at ``length`` (or
+        to ``landing`` when it is near: no sliver of a step is left) and cut back until it
+        converges; returns the step and the length it was taken at. Raises NumericalError
+        when the length falls below ``min_increment`` of the end time."""
+        sim, end = self.run.sim, self.run.deck.solver.end_time
+        cutbacks = 0
+        while True:
+            remaining = landing - sim.state.t
+            target = landing if remaining <= 1.25 * length else sim.state.t + length
+            try:
+                iterations, residual = self.step(target)
+                return NewtonStep(t=target, iterations=iterations, residual=residual, cutbacks=cutbacks), length
+            except NotConverged as why:
+                self.eq.converged.restore(sim)
+                cutbacks += 1
+                length = min(length, remaining) * CUT
+                if length < self.settings.min_increment * end:
+                    raise NumericalError(_not_converged(self.run, self, target, str(why))) from None
 
     def commit(self) -> None:
         """The state is converged: steps now start from it."""
@@ -111,54 +129,26 @@ def solve_static(run: Run, listener: Listener | None = None) -> Run:
     ``run.status = 'interrupted'``.
     """
     listener = listener or Listener()
-    settings = run.deck.solver.static
     end = run.deck.solver.end_time
     sim = run.sim
-    start = time.perf_counter()
-    try:
+    with ending(run, listener, "not converged"):  # a breaking frame is the last converged state
         newton = NewtonSolver(run)
         run.startup["first_dt_s"] = 0.0
         _record(run, listener)
         _frame(run, listener)
-        largest = end / settings.increments
+        largest = end / run.deck.solver.static.increments
         length = largest
         for landing in output_times(run.deck):
             while sim.state.t < landing - 1e-12 * end:
-                cutbacks = 0
-                while True:
-                    remaining = landing - sim.state.t
-                    # the step lands on the output time when it is near (no sliver of a step left)
-                    target = landing if remaining <= 1.25 * length else sim.state.t + length
-                    try:
-                        iterations, residual = newton.step(target)
-                        break
-                    except NotConverged as why:
-                        newton.eq.converged.restore(sim)
-                        cutbacks += 1
-                        length = min(length, remaining) * CUT
-                        if length < settings.min_increment * end:
-                            raise NumericalError(_not_converged(run, newton, target, str(why))) from None
-                sim.state.t = target
+                step, length = newton.reach(landing, length)
+                sim.state.t = step.t
                 sim.state.steps += 1
                 newton.commit()
-                run.newton.append(NewtonStep(t=target, iterations=iterations, residual=residual, cutbacks=cutbacks))
+                run.newton.append(step)
                 _record(run, listener)
-                if iterations <= GROWTH_ITERATIONS and cutbacks == 0:
+                if step.iterations <= GROWTH_ITERATIONS and step.cutbacks == 0:
                     length = min(length * GROW, largest)
             _frame(run, listener)
-        run.status = "completed"
-    except SceneTooLarge:
-        run.status = "refused"
-        raise
-    except NumericalError:
-        run.status = "not converged"
-        _breaking_frame(run, listener)  # the last converged state
-        raise
-    except KeyboardInterrupt:
-        run.status = "interrupted"
-        raise
-    finally:
-        run.wall_time = time.perf_counter() - start
     return run
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..bundles import Model
+from ..model import orthonormal
 
 #: Columns of a node's row in :attr:`Unknowns.index`: three translations in the node's
 #: frame, then the two rotations.
@@ -67,12 +68,7 @@ def unknowns(model: Model) -> Unknowns:
         values, vectors = np.linalg.eigh(constraints.projector[node])
         free = list(vectors[:, values > 0.5].T)
         moved = [np.eye(3)[axis] for _, axis in prescribed_axes[node]]
-        columns = free + moved
-        for axis in np.eye(3):  # complete the frame with the fixed directions
-            rest = axis - sum(((c @ axis) * c for c in columns), np.zeros(3))
-            if len(columns) < 3 and np.linalg.norm(rest) > 1e-6:
-                columns.append(rest / np.linalg.norm(rest))
-        frames[node] = np.asarray(columns).T
+        frames[node] = np.asarray(orthonormal(free + moved + list(np.eye(3)))).T  # completed by the fixed rest
         for k in range(len(free)):
             index[node, k] = n_free
             n_free += 1

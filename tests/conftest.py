@@ -57,10 +57,9 @@ def prepared(deck):
 
 def run_deck(deck):
     """``deck`` run to its end time (or solved statically over it)."""
-    from shellsim.solver.run import integrate
-    from shellsim.solver.static import solve_static
+    from shellsim.execute import solve
 
-    return (solve_static if deck.solver.method == "static" else integrate)(prepared(deck))
+    return solve(prepared(deck))
 
 
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:

@@ -1,7 +1,8 @@
 """The static solver: its tangent against differences of the residual along random
 directions (every material path, distorted curved elements, a follower pressure and a
-moment), against the stiffness product at rest, Newton's quadratic convergence, and a
-step that cannot converge stopped with a message that says where."""
+moment), against the stiffness product at rest, Newton's quadratic convergence, a step
+that cannot converge stopped with a message that says where, arc length through a limit
+point, reactions and load factors, and a preload handed to the explicit solver."""
 
 from __future__ import annotations
 
@@ -19,8 +20,9 @@ from shellsim.model import build_model
 from shellsim.solver.equilibrium import Converged, Equilibrium
 from shellsim.solver.run import prepare
 from shellsim.solver.static import NewtonSolver
+from shellsim.verify.analytic import sphere_inflation_path
 
-from .conftest import ROOT, deck_text
+from .conftest import ROOT, deck_text, run_deck
 
 PANEL = """builder = "cylindrical_panel"
 radius = 2.0
@@ -196,3 +198,101 @@ def test_a_step_that_cannot_converge_is_stopped_with_where(tmp_path):
     assert "did not converge" in said and "% of solver.end_time" in said and "largest residual force is at node" in said
     history = (tmp_path / "out" / "history.csv").read_text().splitlines()
     assert len(history) >= 3  # the header, t = 0 and the steps before the limit point
+
+
+def _history(run, name: str) -> np.ndarray:
+    return np.asarray(run.history[name])
+
+
+def test_arc_length_follows_a_balloon_over_its_pressure_maximum():
+    """A neo-Hookean balloon past the top of its pressure-radius curve, where load control
+    stops: the path's pressure at every step's inner radius is the exact sphere's
+    (sphere_inflation_path) within 1%, and the path goes well beyond the maximum (the
+    pressure falls by more than 10% of it while the radius keeps growing)."""
+    deck = parse_deck((ROOT / "decks" / "verification" / "balloon_limit_point_arc_length.toml").read_text())
+    run = run_deck(deck)
+    assert run.status == "completed"
+    radius, pressure = _history(run, "inner_radius")[1:], 1e3 * _history(run, "load_factor_ramp")[1:]
+    exact = sphere_inflation_path(radius, 0.010, 0.0001, 1e4)
+    assert np.abs(pressure / exact - 1).max() <= 0.01
+    top = int(np.argmax(pressure))
+    assert 0 < top < len(pressure) - 1 and pressure[-1] < 0.9 * pressure[top]
+    assert np.all(np.diff(radius) > 0)  # one way along the path: no step went back
+
+
+def test_sphere_inflation_path_meets_the_thin_membrane_formula():
+    """The exact thick sphere against the thin-membrane balloon, P = 4 C1 (H/R) (1/l - 1/l^7)
+    (l = r/R at mid-wall), as the wall thins: their difference falls like H/R."""
+    for H in (1e-3, 1e-4):
+        stretch = np.linspace(1.05, 2.0, 6)
+        mid = 0.010 + H / 2
+        inner = np.cbrt((stretch * mid) ** 3 - (mid**3 - 0.010**3))
+        exact = sphere_inflation_path(inner, 0.010, H, 1.0)
+        thin = 4 * (H / mid) * (1 / stretch - stretch**-7.0)
+        assert np.abs(exact / thin - 1).max() <= 2 * H / 0.010
+
+
+def test_the_reaction_balances_the_load_and_the_load_factor_is_recorded():
+    """Test 2's cantilever solved statically: the clamp's reaction equals the dead load
+    on the beam (28.5 upward) at every step, and the history's load factor of the static
+    ramp is the load time's share of the span."""
+    text = (ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3_static.toml").read_text()
+    text = text.replace("[[reference]]", '''[[output.probe]]
+name = "clamp_reaction"
+quantity = "reaction"
+set = "x0"
+component = "z"
+
+[[reference]]''')
+    run = run_deck(parse_deck(text))
+    factor = _history(run, "load_factor")
+    assert np.allclose(factor, np.asarray(run.times) / run.deck.solver.end_time)
+    assert np.allclose(_history(run, "clamp_reaction"), 28.5 * factor, rtol=1e-6, atol=1e-9)
+
+
+def _preloaded_aorta(tmp_path, end_time: float) -> str:
+    """Test 9's aorta inflated statically to 18.66 kPa at t = 0.14 (preload), then held
+    explicitly to ``end_time``."""
+    text = (ROOT / "decks" / "verification" / "test09_aorta_static.toml").read_text()
+    text = text.replace('method = "static"\nend_time = 0.16', f"end_time = {end_time}\npreload = 0.14")
+    return text[:text.index("[[reference]]")]
+
+
+def test_a_preload_hands_its_equilibrium_to_the_explicit_run_without_a_jump(tmp_path):
+    """Test 9's aorta solved statically to 18.66 kPa, then integrated explicitly with the
+    pressure held: the explicit phase starts from the equilibrium at rest, so nothing
+    moves: radius, wall thickness and stress stay within 1e-4 of their change over the
+    preload, and the kinetic energy stays 1e-6 below the work it would take to undo it."""
+    run = run_deck(parse_deck(_preloaded_aorta(tmp_path, 0.15)))
+    assert run.status == "completed" and run.newton and run.sim.state.steps > 100
+    times = np.asarray(run.times)
+    handover = int(np.flatnonzero(np.isclose(times, 0.14))[-1])
+    assert handover < len(times) - 10  # the explicit phase sampled after it
+    for name in ("inner_radius", "wall_thickness", "stress_xx"):
+        values = _history(run, name)
+        change = abs(values[handover] - values[0])
+        assert np.abs(values[handover:] - values[handover]).max() <= 1e-4 * change, name
+    kinetic = np.asarray(run.energies)[handover:, 1]
+    strain_work = 18.66e3 * np.pi * 0.01**2 * 0.04 * (_history(run, "inner_radius")[handover] / 0.01 - 1)
+    assert kinetic.max() <= 1e-6 * strain_work
+    assert np.allclose(_history(run, "load_factor_ramp")[handover:], 1.0)
+
+
+def test_preload_and_arc_length_settings_that_cannot_work_are_refused(tmp_path):
+    """A preload at or past the end, a preload on a static run, and arc-length control
+    with a prescribed motion are deck errors naming the key."""
+    aorta = _preloaded_aorta(tmp_path, 0.16)
+    cases = {
+        "late": (aorta.replace("preload = 0.14", "preload = 0.2"), "must come before end_time"),
+        "static": (aorta.replace("preload = 0.14", 'preload = 0.14\nmethod = "static"'), "static throughout"),
+        "prescribed": ((ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3_static.toml").read_text()
+                       .replace("static = { increments = 4 }", 'static = { control = "arc_length" }')
+                       .replace("[[load]]", '[[boundary]]\ntype = "prescribed"\nset = "tip"\ntranslation = "z"\n'
+                                            'value = -1.0\n\n[[load]]'), "prescribe a motion"),
+    }
+    for name, (text, said) in cases.items():
+        deck = tmp_path / f"{name}.toml"
+        deck.write_text(text)
+        result = CliRunner().invoke(app, ["check", str(deck)])
+        assert result.exit_code == 2, (name, result.output)
+        assert said in " ".join(result.output.split()), (name, result.output)

@@ -52,6 +52,19 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
     return run
 
 
+def solve(run: Run, listener: Listener | None = None) -> Run:
+    """Solve ``run`` by its deck's method: statically, explicitly, or explicitly after a
+    static preload."""
+    from .solver.preload import preload_then_integrate
+    from .solver.run import integrate
+    from .solver.static import solve_static
+
+    solver = run.deck.solver
+    method = (solve_static if solver.method == "static" else
+              integrate if solver.preload is None else preload_then_integrate)
+    return method(run, listener)
+
+
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
               announce: Callable[[str], None] = _silent) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
@@ -66,8 +79,7 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .output.series import FrameWriter, check_space
     from .output.summary import summary, write_json
     from .plan import plan
-    from .solver.run import integrate, output_times
-    from .solver.static import solve_static
+    from .solver.run import output_times
 
     current = built_run(scene, deck_path.parent, announce)
     write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
@@ -78,7 +90,6 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
         check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
         writers = Timed(Listeners(history, frames))
         try:
-            solve = solve_static if scene.solver.method == "static" else integrate
             solve(current, Listeners(writers, progress or Listener()))
         except (NumericalError, SceneTooLarge) as error:
             message = str(error)

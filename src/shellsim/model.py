@@ -262,17 +262,20 @@ def _curve_index(deck: Deck, name: str | None) -> int:
     """The index of curve ``name`` in the tables; a load without one is constant (-1), or in
     a static solve follows the ramp after the deck's curves (:func:`_curve_tables`)."""
     if name is None:
-        return len(deck.curves) if deck.solver.method == "static" else -1
+        return -1 if deck.solver.ramp_end is None else len(deck.curves)
     return list(deck.curves).index(name)
 
 
 def _curve_tables(deck: Deck, names: list[str]) -> Curves:
-    """The deck's curves as padded tables; a static solve appends the linear ramp from 0 at
-    t = 0 to 1 at the end time that its loads without a curve follow."""
+    """The deck's curves as padded tables; a static solve or a preload appends the linear
+    ramp from 0 at t = 0 to 1 at its end that loads without a curve follow: on beyond the
+    end of a static run, where an arc-length path may take the load time, held after a
+    preload."""
     tables = [deck.curves[name].table() for name in names]
-    if deck.solver.method == "static":
-        tables.append((np.array([0.0, deck.solver.end_time]), np.array([0.0, 1.0]), INTERPOLATION["linear"],
-                       EXTRAPOLATION["constant"]))
+    end = deck.solver.ramp_end
+    if end is not None:
+        beyond = EXTRAPOLATION["linear" if deck.solver.method == "static" else "constant"]
+        tables.append((np.array([0.0, end]), np.array([0.0, 1.0]), INTERPOLATION["linear"], beyond))
     size = max([len(times) for times, *_ in tables], default=1)
     t = np.zeros((max(len(tables), 1), size))
     v = np.zeros_like(t)

@@ -12,6 +12,17 @@ import difflib
 from .schema import Deck
 
 
+def load_factor_columns(deck: Deck) -> dict[str, int]:
+    """The history columns of the curves' factors at the load time, each with its curve's
+    index in the model's tables: ``load_factor_<curve>`` for every deck curve, and
+    ``load_factor`` for the ramp that the loads without a curve of a static solve or a
+    preload follow."""
+    columns = {f"load_factor_{name}": index for index, name in enumerate(deck.curves)}
+    if deck.solver.ramp_end is not None:
+        columns["load_factor"] = len(deck.curves)
+    return columns
+
+
 def did_you_mean(word: str, choices: list[str] | tuple[str, ...]) -> str:
     """'; did you mean 'x'?' when a choice is close to ``word``, else ''."""
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
@@ -68,9 +79,13 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
     for i, load in enumerate(deck.load):
         need_set(f"load[{i}].set", load.set, load.SET_KINDS)
         need_curve(f"load[{i}].curve", load.curve)
+    factors = list(load_factor_columns(deck))
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)
-    probes = [p.name for p in deck.output.probe]
+        if probe.name in factors:
+            problems.append(f"output.probe[{i}].name: '{probe.name}' is the history's column of a curve's load "
+                            "factor; choose another name")
+    probes = [p.name for p in deck.output.probe] + factors
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:
             problems.append(

@@ -226,8 +226,19 @@ class Static(Section):
     converges in a few iterations grows by half, down to ``min_increment`` of the span).
     An iteration has converged when the residual force is within ``force_tolerance`` of
     the largest of the external and internal force norms and the residual's work on the
-    correction within ``energy_tolerance`` of the step's first."""
+    correction within ``energy_tolerance`` of the step's first.
 
+    ``control = "arc_length"`` follows the equilibrium path through limit points instead
+    (a snapping shell, a tube past its inflation maximum): each step moves the
+    translations a fixed distance and finds the load time with the shape, so the load
+    may fall as well as rise. The first step is as long as the linear response to the
+    first of ``increments``; later steps grow or shrink with the iterations they take,
+    to at most four times the first, and are cut to a quarter when they fail (down to
+    ``min_increment`` of the first). The run's clock is then the load time's path length
+    (the load time until the first limit point); it ends at the first step that passes
+    ``end_time``, and history.csv's load factors tell the load reached."""
+
+    control: Literal["load", "arc_length"] = "load"
     increments: Count = 1
     max_iterations: Count = 16
     force_tolerance: Positive = 1e-6
@@ -244,23 +255,50 @@ class Solver(Section):
     Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
     inverse), Δt_critical re-estimated every ``dt_update_every`` steps. ``mass``: lumped M1
     (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
-    coefficient in 1/s (0 = undamped, the default)."""
+    coefficient in 1/s (0 = undamped, the default).
+
+    ``preload``: a time before ``end_time`` up to which an explicit run is solved
+    statically instead (load steps of ``[solver.static]``), the way an explicit code's
+    dynamic relaxation or a preceding static step sets up a prestressed state: the
+    integration then starts from rest in that equilibrium, its stresses and fibre lengths
+    carried over, and the frames and history show both phases in one time series. A
+    load without a curve grows linearly to its value over the preload and then holds."""
 
     method: Literal["explicit", "static"] = "explicit"
     static: Static = Static()
     end_time: Positive
+    preload: Positive | None = None
     dt_safety_factor: Positive = 1.25
     dt_update_every: Count = 100
     dt_max: Positive | None = None
     mass: Literal["M1", "M2"] = "M2"
     damping: NonNegative = 0.0
 
+    @model_validator(mode="after")
+    def _preload_fits(self) -> "Solver":
+        if self.preload is None:
+            return self
+        if self.method == "static":
+            raise ValueError("'preload' solves the start of an explicit run statically; a static run is static "
+                             "throughout, so drop it or set method = 'explicit'")
+        if self.preload >= self.end_time:
+            raise ValueError(f"preload = {self.preload} must come before end_time = {self.end_time}")
+        if self.static.control != "load":
+            raise ValueError("a preload reaches its time by load steps: static.control must be 'load'")
+        return self
+
+    @property
+    def ramp_end(self) -> float | None:
+        """The time over which loads without a curve grow from 0 to their value: the span
+        of a static run, a preload; None when they act in full from the start."""
+        return self.end_time if self.method == "static" else self.preload
+
 
 OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
     "pressure_band", "green_lagrange_strain", "von_mises",
 ]
-VECTOR_QUANTITIES = ("displacement", "position", "director")
+VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
 TENSOR_QUANTITIES = ("stress", "strain")
 SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
 
@@ -275,7 +313,10 @@ class Probe(Section):
     (a set of several nodes gives their mean). ``stress`` (Cauchy), ``strain``
     (Green-Lagrange) and ``pressure_band`` (-trace(stress) / 3) are read at the integration
     point nearest to the set (mean through the thickness, global axes), as stress
-    benchmarks compare values at Gauss points. ``face`` reads a position or
+    benchmarks compare values at Gauss points. ``reaction`` is the force the supports
+    and prescribed motions exert on the set, summed over its nodes (each node's internal
+    less external force along the directions it is held in: the load a test rig would
+    measure). ``face`` reads a position or
     displacement on the bottom or top face (along the director, half the current fibre
     length from the mid-surface), e.g. the inner radius of a vessel.
 
@@ -283,12 +324,13 @@ class Probe(Section):
     cylindrical axes about the line through ``origin`` along ``axis``, at the probe's
     initial place (a position's radial component is its distance from the axis, a
     stress's circumferential one the hoop stress); ``along`` takes the component along
-    ``direction``. Over a set of several nodes, each node's component is averaged."""
+    ``direction``. Over a set of several nodes, each node's component is averaged (a
+    reaction's summed)."""
 
     name: Name
     quantity: Literal[
         "displacement", "position", "director", "rotation", "thickness", "stress", "strain",
-        "pressure_band",
+        "pressure_band", "reaction",
     ]
     set: Name
     component: Literal[
@@ -471,6 +513,12 @@ class Deck(Section):
         if self.material.HYPERELASTIC and self.section.technique is None:
             problems.append("section.technique: a hyperelastic material needs a large-strain technique (1, 2 or 3)")
         problems += proportion_problems(self.geometry, self.section.thickness)
+        if self.solver.method == "static" and self.solver.static.control == "arc_length":
+            moved = [f"boundary[{i}]" for i, b in enumerate(self.boundary) if b.type == "prescribed" and b.value != 0]
+            if moved:
+                problems.append(f"solver.static.control = 'arc_length' finds the load with the shape, but "
+                                f"{', '.join(moved)} prescribe a motion; use control = 'load' for displacement "
+                                "control")
         if problems:
             raise ValueError("\n".join(problems))
         return self

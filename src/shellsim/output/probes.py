@@ -81,6 +81,12 @@ def resolve_probes(tables: list[ProbeTable], mesh: Mesh, model: Model) -> list[P
     return probes
 
 
+def held(projector: np.ndarray, force: np.ndarray) -> np.ndarray:
+    """The parts (k, 3) of nodal forces ``force`` (k, 3) along the directions the supports
+    hold, of nodes whose allowed translations ``projector`` (k, 3, 3) projects onto."""
+    return force - np.einsum("kij,kj->ki", projector, force)
+
+
 def probe_value(sim, probe: Probe) -> float:
     """The probe's current value in ``sim`` (a :class:`shellsim.solver.simulation.Simulation`;
     the mean over the probe's nodes)."""
@@ -99,6 +105,12 @@ def probe_value(sim, probe: Probe) -> float:
         return float(s.h[nodes].mean())
     if probe.quantity == "rotation":
         return float(np.linalg.norm(s.theta[nodes], axis=1).mean())
+    if probe.quantity == "reaction":
+        vectors = held(m.constraints.projector[nodes], s.f_int[nodes] - s.f_ext[nodes])
+        if probe.directions is not None:
+            return float(np.einsum("ki,ki->", vectors, probe.directions))
+        total = vectors.sum(axis=0)
+        return float(np.linalg.norm(total) if probe.component == "magnitude" else total["xyz".index(probe.component)])
     if probe.quantity == "director":
         vectors = s.d[nodes]
     else:  # a position or displacement on the probe's face

@@ -37,6 +37,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "title": run.deck.meta.title,
         "version": __version__,
         "status": run.status,
+        "method": run.deck.solver.method + (" after a static preload" if run.deck.solver.preload else ""),
         "message": message,
         "elements": model.n_elements,
         "nodes": model.n_nodes,
@@ -60,7 +61,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         },
         "features": {"used": plan.used(), "left_out": plan.left_out()},
         **large_strain,
-        **({"static": static_record(run)} if run.deck.solver.method == "static" else {}),
+        **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
         "reference": reference_results(run),
     }
 

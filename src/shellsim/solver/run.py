@@ -17,7 +17,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..curve_tables import factor
 from ..deck import Deck
+from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
 from ..mesh import Mesh
 from ..model import Model
@@ -59,6 +61,12 @@ class Run:
     lowest: Worst | None = None  # the worst element seen over the run
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
+
+    @property
+    def load_time(self) -> float:
+        """The time the loads read their curves at: the clock, but for an arc-length path
+        (:mod:`shellsim.solver.arc_length`) the load time its last step reached."""
+        return self.newton[-1].load_time if self.newton else self.sim.state.t
 
     @property
     def balance_error(self) -> float:
@@ -140,7 +148,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     probes = resolve_probes(deck.output.probe, mesh, model)
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
               quality=ElementQuality(mesh))
-    run.history = {p.name: [] for p in probes}
+    run.history = {p.name: [] for p in probes} | {name: [] for name in load_factor_columns(deck)}
     return run
 
 
@@ -163,6 +171,8 @@ def _record(run: Run, listener: Listener) -> None:
     run.times.append(run.sim.state.t)
     for p in run.probes:
         run.history[p.name].append(probe_value(run.sim, p))
+    for name, index in load_factor_columns(run.deck).items():
+        run.history[name].append(factor(run.model.curves, index, run.load_time))
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
 
@@ -245,7 +255,8 @@ def _time_step_hint(run: Run) -> str:
 
 
 def integrate(run: Run, listener: Listener | None = None) -> Run:
-    """Integrate the scene from t = 0 to the deck's end time.
+    """Integrate the scene from its state's time (0, or the end of a preload) to the
+    deck's end time.
 
     Raises SceneTooLarge (status 'refused') when its steps would take longer than anyone
     waits, before the first sample; NumericalError when the run goes unstable (the samples recorded until then stay
@@ -258,11 +269,12 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
         _update_time_step(run, listener)
         refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
         run.startup["first_dt_s"] = time.perf_counter() - start
-        _record(run, listener)
-        _frame(run, listener)
+        if not run.times:  # else it continues a preload, whose last state is recorded
+            _record(run, listener)
+            _frame(run, listener)
         since_update = 0
         history_interval = solver.end_time / HISTORY_SAMPLES
-        for landing in output_times(run.deck):
+        for landing in output_times(run.deck)[output_times(run.deck) > sim.state.t]:
             while sim.state.t < landing:
                 # equal steps up to the next output time, history samples on whole steps
                 step = equal_step(landing - sim.state.t, run.dt)
@@ -301,7 +313,7 @@ def ending(run: Run, listener: Listener, broken: str, cause: Callable[[Run], str
         run.status = "interrupted"
         raise
     finally:
-        run.wall_time = time.perf_counter() - start
+        run.wall_time += time.perf_counter() - start  # a preloaded run's phases add up
 
 
 def dt_statistics(run: Run) -> dict:

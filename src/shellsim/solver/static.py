@@ -26,10 +26,12 @@ CUT, GROW, GROWTH_ITERATIONS = 0.25, 1.5, 4
 
 @dataclass
 class NewtonStep:
-    """A converged load step: its end t, the iterations it took, the relative residual it
+    """A converged load step: the run's clock t at its end and the load time it reached
+    (the same under load control), the iterations it took, the relative residual it
     ended with, and the tries cut back before it converged."""
 
     t: float
+    load_time: float
     iterations: int
     residual: float
     cutbacks: int
@@ -57,6 +59,23 @@ class NewtonSolver:
         self.eq = Equilibrium(run.sim)
         self.n_free = self.eq.unknowns.n_free
         self.last_residual = np.zeros(self.n_free)
+        self.extent = float(np.abs(run.model.x0).max())
+
+    def round_off(self, tangent) -> float:
+        """The residual's round-off floor at a tangent (n_free, size): machine epsilon times
+        each free row's diagonal stiffness times the model's extent, over the free rows.
+        The internal forces come from positions of that size, so a residual below it is
+        noise (it is what a small load step near the start stalls at)."""
+        diagonal = np.abs(tangent[:, :self.n_free].diagonal())
+        return float(np.finfo(float).eps * self.extent * np.linalg.norm(diagonal))
+
+    def converged(self, norm: float, scale: float, energy: float, energy_scale: float, floor: float) -> bool:
+        """Whether an iterate is in equilibrium: its residual ``norm`` within the force
+        tolerance of ``scale`` and the ``energy`` of its next correction within the energy
+        tolerance of ``energy_scale``, or the residual down to the round-off ``floor``."""
+        settings = self.settings
+        return norm <= floor or (norm <= settings.force_tolerance * scale
+                                 and energy <= settings.energy_tolerance * energy_scale)
 
     def step(self, t: float) -> tuple[int, float]:
         """Equilibrium at load time t from the converged state; returns (iterations,
@@ -66,7 +85,7 @@ class NewtonSolver:
         residual = eq.residual()[:n_free]
         known = eq.prescribed_increments(t)
         first_energy = None
-        lu = None
+        lu, floor = None, 0.0
         for iteration in range(settings.max_iterations + 1):
             scale = eq.force_scale()
             if not np.all(np.isfinite(residual)):
@@ -78,13 +97,13 @@ class NewtonSolver:
             if iteration > 0:
                 # the energy of the next correction, with the last factorisation
                 energy = abs(float(lu.solve(residual) @ residual))
-                if norm <= settings.force_tolerance * scale and energy <= settings.energy_tolerance * first_energy:
+                if self.converged(norm, scale, energy, first_energy, floor):
                     return iteration, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale")
             tangent = eq.tangent()
-            lu = _factorised(tangent[:, :n_free])
+            lu, floor = _factorised(tangent[:, :n_free]), self.round_off(tangent)
             rhs = residual - tangent[:, n_free:] @ known if iteration == 0 and len(known) else residual
             correction = lu.solve(rhs)
             if first_energy is None:
@@ -106,60 +125,73 @@ class NewtonSolver:
             target = landing if remaining <= 1.25 * length else sim.state.t + length
             try:
                 iterations, residual = self.step(target)
-                return NewtonStep(t=target, iterations=iterations, residual=residual, cutbacks=cutbacks), length
+                step = NewtonStep(t=target, load_time=target, iterations=iterations, residual=residual,
+                                  cutbacks=cutbacks)
+                return step, length
             except NotConverged as why:
                 self.eq.converged.restore(sim)
                 cutbacks += 1
                 length = min(length, remaining) * CUT
                 if length < self.settings.min_increment * end:
-                    raise NumericalError(_not_converged(self.run, self, target, str(why))) from None
+                    where = (f"on the way from t = {sim.state.t:.6g} to t = {target:.6g} "
+                             f"({100 * target / end:.3g}% of solver.end_time) even in steps of "
+                             f"{self.settings.min_increment:g} of it")
+                    raise NumericalError(not_converged(self.run, self, where, str(why))) from None
 
-    def commit(self) -> None:
-        """The state is converged: steps now start from it."""
+    def commit(self, step: NewtonStep) -> None:
+        """The state is converged at ``step``'s end: steps now start from it."""
+        self.run.sim.state.steps += 1
         self.eq.converged = Converged(self.run.sim)
+        self.run.newton.append(step)
 
 
-def solve_static(run: Run, listener: Listener | None = None) -> Run:
-    """Solve the scene statically from t = 0 to the deck's end time, sampling the history
-    at every converged step and writing frames at the output times.
+def solve_static(run: Run, listener: Listener | None = None, until: float | None = None) -> Run:
+    """Solve the scene statically from t = 0 to the deck's end time (or ``until``, a
+    preload's end), by load steps or along the path (``solver.static.control``),
+    sampling the history at every converged step and writing frames at the output times.
 
-    Raises NumericalError (status 'not converged') naming the load time, the residual and
-    the worst place when a step cannot be solved even cut to ``min_increment``; the
+    Raises NumericalError (status 'not converged') naming where in the load, the residual
+    and the worst place when a step cannot be solved even cut to ``min_increment``; the
     samples and frames until then are kept. KeyboardInterrupt passes through with
     ``run.status = 'interrupted'``.
     """
+    from .arc_length import follow_path
+
     listener = listener or Listener()
-    end = run.deck.solver.end_time
-    sim = run.sim
     with ending(run, listener, "not converged"):  # a breaking frame is the last converged state
         newton = NewtonSolver(run)
         run.startup["first_dt_s"] = 0.0
         _record(run, listener)
         _frame(run, listener)
-        largest = end / run.deck.solver.static.increments
-        length = largest
-        for landing in output_times(run.deck):
-            while sim.state.t < landing - 1e-12 * end:
-                step, length = newton.reach(landing, length)
-                sim.state.t = step.t
-                sim.state.steps += 1
-                newton.commit()
-                run.newton.append(step)
-                _record(run, listener)
-                if step.iterations <= GROWTH_ITERATIONS and step.cutbacks == 0:
-                    length = min(length * GROW, largest)
-            _frame(run, listener)
+        if run.deck.solver.static.control == "arc_length":
+            follow_path(run, newton, listener)
+        else:
+            _load_steps(run, newton, listener, until or run.deck.solver.end_time)
     return run
 
 
-def _not_converged(run: Run, newton: NewtonSolver, target: float, why: str) -> str:
-    """The message of a step that cannot be solved: where in the load, why, the node with
-    the largest residual force and its place, and any folded element."""
-    end = run.deck.solver.end_time
+def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) -> None:
+    """Load control to ``end``: steps that land on every output time before it."""
+    sim = run.sim
+    largest = end / run.deck.solver.static.increments
+    length = largest
+    landings = output_times(run.deck)
+    for landing in np.append(landings[landings < end], end):
+        while sim.state.t < landing - 1e-12 * end:
+            step, length = newton.reach(landing, length)
+            sim.state.t = step.t
+            newton.commit(step)
+            _record(run, listener)
+            if step.iterations <= GROWTH_ITERATIONS and step.cutbacks == 0:
+                length = min(length * GROW, largest)
+        _frame(run, listener)
+
+
+def not_converged(run: Run, newton: NewtonSolver, where: str, why: str) -> str:
+    """The message of a step that cannot be solved: ``where`` in the load, why, the node
+    with the largest residual force and its place, and any folded element."""
     s = run.sim.state
-    message = (f"the static solve did not converge on the way from t = {s.t:.6g} to t = {target:.6g} "
-               f"({100 * target / end:.3g}% of solver.end_time) even in steps of "
-               f"{run.deck.solver.static.min_increment:g} of it: {why}")
+    message = f"the static solve did not converge {where}: {why}"
     local = newton.eq.unknowns.scatter(np.concatenate([newton.last_residual, np.zeros(newton.eq.unknowns.n_known)]))
     per_node = np.linalg.norm(local, axis=1)
     if per_node.max() > 0:

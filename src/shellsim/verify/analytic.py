@@ -1,4 +1,5 @@
-"""Semi-analytic references: closed-end inflation of an incompressible anisotropic tube.
+"""Semi-analytic references: closed-end inflation of an incompressible anisotropic tube,
+and the inflation of a neo-Hookean sphere (:func:`sphere_inflation_path`).
 
 Exact 3D solution (benchmarks.md, Tests 9 and 10) for the Guccione law of thesis Eq 4.2
 in cylindrical axes (t circumferential, z axial, r radial):
@@ -95,3 +96,26 @@ def through_wall_stresses(pressure: float, R, inner_radius: float, wall_thicknes
     s_rr = np.array([-quad(hoop, Ri, R_o, epsrel=1e-12)[0] for Ri in R])
     D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, C)
     return s_rr, s_rr + D_t, s_rr + D_z
+
+
+def sphere_inflation_path(inner_radii, inner_radius: float, wall_thickness: float, C1: float) -> np.ndarray:
+    """Pressure (m,) [stress units] of an incompressible neo-Hookean sphere,
+    W = C1 (I1 - 3), at each inner radius r_i (m,) [length]: the exact 3D inflation of a
+    balloon, whose pressure rises to a maximum and falls beyond it.
+
+    The deformation r^3 = r_i^3 + R^3 - R_i^3 stretches the wall equally in both tangent
+    directions, lambda = r / R, and by 1 / lambda^2 radially; the hoop-radial stress
+    difference is 2 C1 (lambda^2 - lambda^-4), and radial equilibrium with s_rr = -P
+    inside and 0 outside gives P = int 2 (s_tt - s_rr) dr / r, with dr / r = R^2 dR / r^3.
+    """
+    R_i, R_o = inner_radius, inner_radius + wall_thickness
+
+    def pressure(r_i: float) -> float:
+        def integrand(R):
+            r = np.cbrt(r_i**3 + R**3 - R_i**3)
+            lam = r / R
+            return 4.0 * C1 * (lam**2 - lam**-4) * R**2 / r**3
+
+        return quad(integrand, R_i, R_o, epsrel=1e-12)[0]
+
+    return np.array([pressure(r_i) for r_i in np.asarray(inner_radii, dtype=float)])

@@ -1,0 +1,183 @@
+"""Arc-length continuation of a static solve (``solver.static.control = "arc_length"``):
+Crisfield's cylindrical constraint, which follows an equilibrium path through limit
+points where load control stops (a snapping shell, a tube past its inflation maximum).
+
+The load time t, at which the loads read their curves, becomes an unknown beside the
+shape. Each step moves the translations by a fixed length ``l`` along the path,
+
+    ||Delta u||^2 = l^2       (translational unknowns only: rotations have other units),
+
+and solves equilibrium r(u, t) = f_ext(u, t) - f_int(u) = 0 with it. A Newton iteration
+takes the two solutions of K du_r = r and K du_t = q, q = d f_ext / dt (the loads' rate
+in load time, central differences), and the change of load time dt that keeps the
+constraint: the root of a quadratic nearer to the step's direction (Crisfield 1981,
+"A fast incremental/iterative solution procedure that handles snap-through", Computers &
+Structures 13, 55-62). A step's direction follows the last one (the sign of du_t . Delta
+u_previous), so the path turns back at a limit point instead of reversing.
+
+The run's clock is the load time's path length, sum |Delta t|: it equals the load time
+until the first limit point and keeps rising after it, so histories and frames stay in
+order; the load reached is the history's load factor.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..compiled_call import TypedCall
+from ..errors import NumericalError
+from ..loads import external_forces
+from .run import Listener, Run, _frame, _record, output_times
+from .static import CUT, NewtonSolver, NewtonStep, NotConverged, _factorised, not_converged
+
+#: Load-time share of the span by which the loads' rate is differenced.
+RATE_STEP = 1e-6
+#: Iterations a step aims at: the next step's length scales by sqrt(AIM / iterations),
+#: by a factor within GROWTH (Crisfield's rule), up to LONGEST times the first step's.
+AIM, GROWTH, LONGEST = 5, (0.5, 2.0), 4.0
+
+
+class LoadRate:
+    """q = d f_ext / dt over the free unknowns at the state's shape, by central
+    differences of the external forces in load time (scratch arrays of their own, so the
+    last evaluation's forces and pressures stay as they are)."""
+
+    def __init__(self, newton: NewtonSolver):
+        sim = newton.run.sim
+        self.sim, self.unknowns = sim, newton.eq.unknowns
+        n = sim.model.n_nodes
+        space = sim.workspace
+        self.step = RATE_STEP * newton.run.deck.solver.end_time
+        self._f, self._fr, self._g = np.empty((n, 3)), np.empty((n, 2)), np.empty((n, 3))
+        self._pressure, self._edges = np.empty_like(space.scale_pressure), np.empty_like(space.scale_edges)
+        self._external = TypedCall(external_forces)
+
+    def _forces(self, t: float) -> np.ndarray:
+        self._external(float(t), self.sim.model, self.sim.state.fields.shape, self._f, self._fr, self._g,
+                       self._pressure, self._edges)
+        return self.unknowns.gather(self.unknowns.to_local(self._f, self._fr))[:self.unknowns.n_free]
+
+    def __call__(self, t: float) -> np.ndarray:
+        return (self._forces(t + self.step) - self._forces(t - self.step)) / (2 * self.step)
+
+
+class ArcLength:
+    """Steps of a fixed translational length along the equilibrium path of ``newton``'s
+    run, from its converged state."""
+
+    def __init__(self, newton: NewtonSolver):
+        self.newton = newton
+        self.eq, self.settings = newton.eq, newton.settings
+        self.rate = LoadRate(newton)
+        u = newton.eq.unknowns
+        translation = np.zeros(u.index.shape, dtype=bool)
+        translation[:, :3] = True
+        free = (u.index >= 0) & (u.index < u.n_free)
+        self.translation = np.zeros(u.n_free, dtype=bool)
+        self.translation[u.index[free & translation]] = True
+        self.load_time = 0.0
+        self.direction: np.ndarray | None = None  # the last converged step's translations
+
+    def first_length(self, load_step: float) -> float:
+        """The translational length of the linear response to ``load_step`` of load time at
+        the converged state: the path's first step matches load control's first."""
+        eq = self.eq
+        eq.evaluate(self.load_time)
+        lu = _factorised(eq.tangent()[:, :self.newton.n_free])
+        along = lu.solve(self.rate(self.load_time))[self.translation]
+        return abs(load_step) * float(np.linalg.norm(along))
+
+    def step(self, length: float) -> tuple[int, float, float]:
+        """Equilibrium a translational distance ``length`` along the path; returns
+        (iterations, relative residual, change of load time). Raises NotConverged; the
+        state is then wherever the iterations left it."""
+        eq, settings, n_free, m = self.eq, self.settings, self.newton.n_free, self.translation
+        start = t = self.load_time
+        eq.evaluate(t)
+        tangent = eq.tangent()
+        lu, floor = _factorised(tangent[:, :n_free]), self.newton.round_off(tangent)
+        rate = self.rate(t)
+        along = lu.solve(rate)
+        sign = 1.0 if self.direction is None or along[m] @ self.direction >= 0.0 else -1.0
+        change = sign * length / max(float(np.linalg.norm(along[m])), 1e-300)
+        total = change * along
+        eq.move(self._padded(total))
+        t += change
+        for iteration in range(1, settings.max_iterations + 1):
+            eq.evaluate(t)
+            residual = eq.residual()[:n_free]
+            if not np.all(np.isfinite(residual)):
+                raise NotConverged("the residual is no longer a number")
+            self.newton.last_residual = residual
+            scale = eq.force_scale()
+            norm = float(np.linalg.norm(residual))
+            # the energy of the next correction, with the last factorisation
+            energy = abs(float(lu.solve(residual) @ residual))
+            # the energy against the work of the force scale over the step: the predictor's own
+            # work vanishes at a limit point, where the load's change does
+            if self.newton.converged(norm, scale, energy, scale * length, floor):
+                self.direction = total[m]
+                self.load_time = t
+                return iteration, norm / max(scale, 1e-300), t - start
+            tangent = eq.tangent()
+            lu, floor = _factorised(tangent[:, :n_free]), self.newton.round_off(tangent)
+            balance, along = lu.solve(residual), lu.solve(self.rate(t))
+            shift = constrained_shift(total[m] + balance[m], along[m], length, total[m])
+            correction = balance + shift * along
+            eq.move(self._padded(correction))
+            total += correction
+            t += shift
+        raise NotConverged(f"{settings.max_iterations} iterations left a residual of "
+                           f"{norm / max(scale, 1e-300):.3g} of the force scale")
+
+    def _padded(self, free: np.ndarray) -> np.ndarray:
+        """A correction of the free unknowns, with the prescribed ones (held) appended."""
+        return np.concatenate([free, np.zeros(self.eq.unknowns.n_known)])
+
+
+def constrained_shift(moved: np.ndarray, along: np.ndarray, length: float, before: np.ndarray) -> float:
+    """The change of load time s that puts ``moved + s along`` on the sphere of radius
+    ``length``: of the two roots of the quadratic, the one whose increment turns least
+    from ``before`` (the step's increment so far). Raises NotConverged when the sphere is
+    out of reach (no real root)."""
+    a, b, c = along @ along, 2.0 * along @ moved, moved @ moved - length**2
+    discriminant = b * b - 4.0 * a * c
+    if discriminant < 0.0 or a == 0.0:
+        raise NotConverged("the arc-length constraint has no real root (the step is too long for the path's curvature)")
+    roots = (-b + np.array([1.0, -1.0]) * np.sqrt(discriminant)) / (2.0 * a)
+    return float(max(roots, key=lambda s: (moved + s * along) @ before))
+
+
+def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
+    """Arc-length steps from the converged state until the clock (the load time's path
+    length) passes the end time; a frame after each step that passes an output time.
+    The first step is as long as the linear response to the first load step of
+    ``solver.static.increments``, and no later step is longer than LONGEST of it."""
+    sim, end = run.sim, run.deck.solver.end_time
+    settings = run.deck.solver.static
+    arc = ArcLength(newton)
+    first = length = arc.first_length(end / settings.increments)
+    marks = output_times(run.deck)
+    while sim.state.t < end - 1e-12 * end:
+        before = sim.state.t
+        cutbacks = 0
+        while True:
+            try:
+                iterations, residual, change = arc.step(length)
+                break
+            except NotConverged as why:
+                newton.eq.converged.restore(sim)
+                cutbacks += 1
+                length *= CUT
+                if length < settings.min_increment * first:
+                    where = (f"along the path from load time {arc.load_time:.6g} (clock t = {before:.6g}) even in "
+                             f"arc lengths of {settings.min_increment:g} of the first")
+                    raise NumericalError(not_converged(run, newton, where, str(why))) from None
+        sim.state.t = before + abs(change)
+        newton.commit(NewtonStep(t=sim.state.t, load_time=arc.load_time, iterations=iterations,
+                                 residual=residual, cutbacks=cutbacks))
+        _record(run, listener)
+        if np.any((marks > before) & (marks <= sim.state.t + 1e-12 * end)):
+            _frame(run, listener)
+        if cutbacks == 0:
+            length = min(length * float(np.clip(np.sqrt(AIM / max(iterations, 1)), *GROWTH)), LONGEST * first)

@@ -115,7 +115,7 @@ def test_external_points_need_their_columns(tmp_path):
 
 
 #: A run's summary.json, the parts a report row reads.
-SUMMARY = {"status": "completed", "message": "", "dofs": 5, "elements": 1, "steps": 3,
+SUMMARY = {"status": "completed", "method": "explicit", "message": "", "dofs": 5, "elements": 1, "steps": 3,
            "dt": {"mean": 1e-3, "min": 1e-3, "max": 3e-3}, "wall_time_s": 0.1, "us_per_element_step": 1.0,
            "energy": {"balance_error_percent": 0.2}, "reference": []}
 

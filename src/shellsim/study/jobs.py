@@ -93,7 +93,7 @@ def run_job(job: Job) -> dict:
 
 
 #: The columns of a report row, in order.
-COLUMNS = ("family", "variant", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
+COLUMNS = ("family", "variant", "method", "status", "expected", "dofs", "elements", "steps", "mean_dt", "wall_time_s",
            "us_per_element_step", "error_percent", "balance_error_percent", "dt_fall", "passed", "message", "folder")
 
 
@@ -144,7 +144,8 @@ def row(job: Job, summary: dict) -> dict:
     checked = bool(summary["reference"]) or job.balance_within_percent is not None or job.dt_falls_by is not None
     passed = (all(r["passed"] for r in summary["reference"]) and not missed) if checked and completed else None
     return _identity(job) | {
-        "status": summary["status"], "dofs": summary["dofs"], "elements": summary["elements"], "steps": summary["steps"],
+        "status": summary["status"], "method": summary["method"], "dofs": summary["dofs"],
+        "elements": summary["elements"], "steps": summary["steps"],
         "mean_dt": summary["dt"]["mean"], "wall_time_s": summary["wall_time_s"],
         "us_per_element_step": summary["us_per_element_step"],
         "error_percent": max(errors) if errors else None, "balance_error_percent": balance, "dt_fall": fall,

@@ -45,9 +45,9 @@ def _cell(value) -> str:
 
 def table(rows: list[dict]) -> str:
     """The markdown table of ``rows``."""
-    header = ("deck", "variant", "status", "DOFs", "steps", "mean dt", "wall time [s]", "us/element-step",
+    header = ("deck", "variant", "method", "status", "DOFs", "steps", "mean dt", "wall time [s]", "us/element-step",
               "error [%]", "balance [%]", "dt max/min", "passed", "note")
-    keys = ("family", "variant", "status", "dofs", "steps", "mean_dt", "wall_time_s", "us_per_element_step",
+    keys = ("family", "variant", "method", "status", "dofs", "steps", "mean_dt", "wall_time_s", "us_per_element_step",
             "error_percent", "balance_error_percent", "dt_fall", "passed", "message")
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for r in rows:
@@ -103,8 +103,9 @@ def csv_text(rows: list[dict]) -> str:
 
 
 def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> bytes:
-    """Log-log error against wall time: one line per family in ladder order, each point
-    labelled with its variant; other programs' points as open markers."""
+    """Log-log error against wall time: one line per family and method in ladder order
+    (static rungs dashed, in their family's colour), each point labelled with its variant;
+    other programs' points as open markers."""
     from matplotlib import colormaps
     from matplotlib.figure import Figure
 
@@ -113,14 +114,18 @@ def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> byt
     families = list(dict.fromkeys(r["family"] for r in rows))
     colours = colormaps["tab20"].colors  # 20 colours and 7 markers: no two families look alike
     for index, family in enumerate(families):
-        done = [r for r in rows if r["family"] == family and r["error_percent"] and r["wall_time_s"]]
-        if not done:
-            continue
-        line, = ax.plot([r["wall_time_s"] for r in done], [r["error_percent"] for r in done], "-",
-                        marker="os^Dv<>"[index % 7], color=colours[index % len(colours)], label=family)
-        for r in done:
-            ax.annotate(r["variant"], (r["wall_time_s"], r["error_percent"]), textcoords="offset points",
-                        xytext=(4, 4), fontsize="x-small", color=line.get_color())
+        for method in dict.fromkeys(r["method"] for r in rows if r["family"] == family):
+            done = [r for r in rows if r["family"] == family and r["method"] == method and r["error_percent"]
+                    and r["wall_time_s"]]
+            if not done:
+                continue
+            static = method == "static"
+            line, = ax.plot([r["wall_time_s"] for r in done], [r["error_percent"] for r in done],
+                            "--" if static else "-", marker="os^Dv<>"[index % 7], color=colours[index % len(colours)],
+                            label=f"{family}, static" if static else family)
+            for r in done:
+                ax.annotate(r["variant"], (r["wall_time_s"], r["error_percent"]), textcoords="offset points",
+                            xytext=(4, 4), fontsize="x-small", color=line.get_color())
     for program in dict.fromkeys(e["program"] for e in external):
         points = [e for e in external if e["program"] == program]
         ax.plot([e["wall_time_s"] for e in points], [e["error_percent"] for e in points], "s", mfc="none",

@@ -438,12 +438,17 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     sv = scene.solver
     if sv.method == "static":
         st = sv.static
-        table.add_row("solver", f"static: Newton-Raphson load steps to t = {sv.end_time}, {st.increments} "
+        steps = ("arc-length steps along the path (the load found with the shape) until the clock passes"
+                 if st.control == "arc_length" else "Newton-Raphson load steps to")
+        table.add_row("solver", f"static: {steps} t = {sv.end_time}, {st.increments} "
                                 f"first, at most {st.max_iterations} iterations each, tolerances force "
                                 f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")
         table.add_row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
                               f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
     else:
+        if sv.preload is not None:
+            table.add_row("preload", f"static load steps to t = {sv.preload} ({sv.static.increments} first), "
+                                     "then the explicit run from rest in that equilibrium")
         table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
                                 f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
                                 + (f", damping {sv.damping}/s" if sv.damping else ""))

@@ -45,6 +45,16 @@ def face_forces(rule, xe, de, he, face, pressure, fe, ge):
 
 
 @njit(cache=True)
+def _gather_face(shape, nodes, xe, de, he):
+    """The mid-surface points, directors and fibre lengths of an element's nodes (9,) into
+    xe, de (9, 3) and he (9,)."""
+    for a in range(9):
+        xe[a] = shape.x[nodes[a]]
+        de[a] = shape.d[nodes[a]]
+        he[a] = shape.h[nodes[a]]
+
+
+@njit(cache=True)
 def pressure_forces(rule, conn, shape, faces, scale, f, g):
     """Adds the forces of pressures ``scale`` (P,) [force/length^2] on ``faces``
     (:class:`shellsim.bundles.PressureLoads`) to f and g (n, 3) (:func:`face_forces`).
@@ -54,10 +64,8 @@ def pressure_forces(rule, conn, shape, faces, scale, f, g):
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
     for m in range(faces.elements.shape[0]):
         nodes = conn[faces.elements[m]]
+        _gather_face(shape, nodes, xe, de, he)
         for a in range(9):
-            xe[a] = shape.x[nodes[a]]
-            de[a] = shape.d[nodes[a]]
-            he[a] = shape.h[nodes[a]]
             fe[a] = f[nodes[a]]  # summed in place: the nodal sums keep the order of every step
             ge[a] = g[nodes[a]]
         face_forces(rule, xe, de, he, faces.face[m], scale[m], fe, ge)
@@ -75,11 +83,9 @@ def pressure_tangents(rule, conn, shape, faces, scale, step_u, step_r, k):
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
     for m in range(faces.elements.shape[0]):
         nodes = conn[faces.elements[m]]
+        _gather_face(shape, nodes, xe, de, he)
         for a in range(9):
-            xe[a] = shape.x[nodes[a]]
-            de[a] = shape.d[nodes[a]]
             e1e[a] = shape.e1[nodes[a]]
-            he[a] = shape.h[nodes[a]]
         k[m] = 0.0
         for move in range(2 * ELEMENT_DOFS):
             moved, node = move // 10, nodes[move // 10]

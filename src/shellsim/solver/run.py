@@ -61,6 +61,7 @@ class Run:
     lowest: Worst | None = None  # the worst element seen over the run
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
+    load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
 
     @property
     def load_time(self) -> float:
@@ -148,7 +149,8 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     probes = resolve_probes(deck.output.probe, mesh, model)
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
               quality=ElementQuality(mesh))
-    run.history = {p.name: [] for p in probes} | {name: [] for name in load_factor_columns(deck)}
+    run.load_factors = load_factor_columns(deck)
+    run.history = {p.name: [] for p in probes} | {name: [] for name in run.load_factors}
     return run
 
 
@@ -171,7 +173,7 @@ def _record(run: Run, listener: Listener) -> None:
     run.times.append(run.sim.state.t)
     for p in run.probes:
         run.history[p.name].append(probe_value(run.sim, p))
-    for name, index in load_factor_columns(run.deck).items():
+    for name, index in run.load_factors.items():
         run.history[name].append(factor(run.model.curves, index, run.load_time))
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
@@ -274,7 +276,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
             _frame(run, listener)
         since_update = 0
         history_interval = solver.end_time / HISTORY_SAMPLES
-        for landing in output_times(run.deck)[output_times(run.deck) > sim.state.t]:
+        landings = output_times(run.deck)
+        for landing in landings[landings > sim.state.t]:
             while sim.state.t < landing:
                 # equal steps up to the next output time, history samples on whole steps
                 step = equal_step(landing - sim.state.t, run.dt)

@@ -28,7 +28,7 @@ from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..loads import external_forces
 from .run import Listener, Run, _frame, _record, output_times
-from .static import CUT, NewtonSolver, NewtonStep, NotConverged, _factorised, not_converged
+from .static import CUT, NewtonSolver, NewtonStep, NotConverged, not_converged
 
 #: Load-time share of the span by which the loads' rate is differenced.
 RATE_STEP = 1e-6
@@ -81,9 +81,8 @@ class ArcLength:
     def first_length(self, load_step: float) -> float:
         """The translational length of the linear response to ``load_step`` of load time at
         the converged state: the path's first step matches load control's first."""
-        eq = self.eq
-        eq.evaluate(self.load_time)
-        lu = _factorised(eq.tangent()[:, :self.newton.n_free])
+        self.eq.evaluate(self.load_time)
+        _, lu, _ = self.newton.linearised()
         along = lu.solve(self.rate(self.load_time))[self.translation]
         return abs(load_step) * float(np.linalg.norm(along))
 
@@ -91,11 +90,10 @@ class ArcLength:
         """Equilibrium a translational distance ``length`` along the path; returns
         (iterations, relative residual, change of load time). Raises NotConverged; the
         state is then wherever the iterations left it."""
-        eq, settings, n_free, m = self.eq, self.settings, self.newton.n_free, self.translation
+        eq, newton, m = self.eq, self.newton, self.translation
         start = t = self.load_time
         eq.evaluate(t)
-        tangent = eq.tangent()
-        lu, floor = _factorised(tangent[:, :n_free]), self.newton.round_off(tangent)
+        _, lu, floor = newton.linearised()
         rate = self.rate(t)
         along = lu.solve(rate)
         sign = 1.0 if self.direction is None or along[m] @ self.direction >= 0.0 else -1.0
@@ -103,32 +101,49 @@ class ArcLength:
         total = change * along
         eq.move(self._padded(total))
         t += change
-        for iteration in range(1, settings.max_iterations + 1):
+        for iteration in range(1, self.settings.max_iterations + 1):
             eq.evaluate(t)
-            residual = eq.residual()[:n_free]
-            if not np.all(np.isfinite(residual)):
-                raise NotConverged("the residual is no longer a number")
-            self.newton.last_residual = residual
+            residual = newton.free_residual()
             scale = eq.force_scale()
             norm = float(np.linalg.norm(residual))
             # the energy of the next correction, with the last factorisation
             energy = abs(float(lu.solve(residual) @ residual))
             # the energy against the work of the force scale over the step: the predictor's own
             # work vanishes at a limit point, where the load's change does
-            if self.newton.converged(norm, scale, energy, scale * length, floor):
+            if newton.converged(norm, scale, energy, scale * length, floor):
                 self.direction = total[m]
                 self.load_time = t
                 return iteration, norm / max(scale, 1e-300), t - start
-            tangent = eq.tangent()
-            lu, floor = _factorised(tangent[:, :n_free]), self.newton.round_off(tangent)
+            _, lu, floor = newton.linearised()
             balance, along = lu.solve(residual), lu.solve(self.rate(t))
             shift = constrained_shift(total[m] + balance[m], along[m], length, total[m])
             correction = balance + shift * along
             eq.move(self._padded(correction))
             total += correction
             t += shift
-        raise NotConverged(f"{settings.max_iterations} iterations left a residual of "
+        raise NotConverged(f"{self.settings.max_iterations} iterations left a residual of "
                            f"{norm / max(scale, 1e-300):.3g} of the force scale")
+
+    def reach(self, length: float, first: float) -> tuple[NewtonStep, float]:
+        """A converged step from the converged state, tried at ``length`` and cut back
+        until it converges; returns the step (its clock t past the state's by the change
+        of load time) and the length it was taken at. Raises NumericalError when the
+        length falls below ``min_increment`` of the ``first``."""
+        sim = self.newton.run.sim
+        cutbacks = 0
+        while True:
+            try:
+                iterations, residual, change = self.step(length)
+                return NewtonStep(t=sim.state.t + abs(change), load_time=self.load_time, iterations=iterations,
+                                  residual=residual, cutbacks=cutbacks), length
+            except NotConverged as why:
+                self.eq.converged.restore(sim)
+                cutbacks += 1
+                length *= CUT
+                if length < self.settings.min_increment * first:
+                    where = (f"along the path from load time {self.load_time:.6g} (clock t = {sim.state.t:.6g}) "
+                             f"even in arc lengths of {self.settings.min_increment:g} of the first")
+                    raise NumericalError(not_converged(self.newton.run, self.newton, where, str(why))) from None
 
     def _padded(self, free: np.ndarray) -> np.ndarray:
         """A correction of the free unknowns, with the prescribed ones (held) appended."""
@@ -154,30 +169,16 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
     The first step is as long as the linear response to the first load step of
     ``solver.static.increments``, and no later step is longer than LONGEST of it."""
     sim, end = run.sim, run.deck.solver.end_time
-    settings = run.deck.solver.static
     arc = ArcLength(newton)
-    first = length = arc.first_length(end / settings.increments)
+    first = length = arc.first_length(end / run.deck.solver.static.increments)
     marks = output_times(run.deck)
     while sim.state.t < end - 1e-12 * end:
         before = sim.state.t
-        cutbacks = 0
-        while True:
-            try:
-                iterations, residual, change = arc.step(length)
-                break
-            except NotConverged as why:
-                newton.eq.converged.restore(sim)
-                cutbacks += 1
-                length *= CUT
-                if length < settings.min_increment * first:
-                    where = (f"along the path from load time {arc.load_time:.6g} (clock t = {before:.6g}) even in "
-                             f"arc lengths of {settings.min_increment:g} of the first")
-                    raise NumericalError(not_converged(run, newton, where, str(why))) from None
-        sim.state.t = before + abs(change)
-        newton.commit(NewtonStep(t=sim.state.t, load_time=arc.load_time, iterations=iterations,
-                                 residual=residual, cutbacks=cutbacks))
+        step, length = arc.reach(length, first)
+        sim.state.t = step.t
+        newton.commit(step)
         _record(run, listener)
         if np.any((marks > before) & (marks <= sim.state.t + 1e-12 * end)):
             _frame(run, listener)
-        if cutbacks == 0:
-            length = min(length * float(np.clip(np.sqrt(AIM / max(iterations, 1)), *GROWTH)), LONGEST * first)
+        if step.cutbacks == 0:
+            length = min(length * float(np.clip(np.sqrt(AIM / max(step.iterations, 1)), *GROWTH)), LONGEST * first)

@@ -69,6 +69,21 @@ class NewtonSolver:
         diagonal = np.abs(tangent[:, :self.n_free].diagonal())
         return float(np.finfo(float).eps * self.extent * np.linalg.norm(diagonal))
 
+    def free_residual(self) -> np.ndarray:
+        """The residual over the free unknowns (n_free,) of the last evaluation, kept for a
+        message; raises NotConverged when it is no longer a number."""
+        residual = self.eq.residual()[:self.n_free]
+        if not np.all(np.isfinite(residual)):
+            raise NotConverged("the residual is no longer a number")
+        self.last_residual = residual
+        return residual
+
+    def linearised(self):
+        """(tangent (n_free, size), the LU factors of its free columns, its round-off
+        floor) at the last evaluation."""
+        tangent = self.eq.tangent()
+        return tangent, _factorised(tangent[:, :self.n_free]), self.round_off(tangent)
+
     def converged(self, norm: float, scale: float, energy: float, energy_scale: float, floor: float) -> bool:
         """Whether an iterate is in equilibrium: its residual ``norm`` within the force
         tolerance of ``scale`` and the ``energy`` of its next correction within the energy
@@ -82,15 +97,12 @@ class NewtonSolver:
         relative residual). Raises NotConverged with the reason."""
         eq, settings, n_free = self.eq, self.settings, self.n_free
         eq.evaluate(t)
-        residual = eq.residual()[:n_free]
         known = eq.prescribed_increments(t)
         first_energy = None
         lu, floor = None, 0.0
         for iteration in range(settings.max_iterations + 1):
+            residual = self.free_residual()
             scale = eq.force_scale()
-            if not np.all(np.isfinite(residual)):
-                raise NotConverged("the residual is no longer a number")
-            self.last_residual = residual  # the last one that was a number, for a message
             norm = float(np.linalg.norm(residual))
             if iteration == 0 and not np.any(known) and norm <= settings.force_tolerance * scale:
                 return 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
@@ -102,15 +114,13 @@ class NewtonSolver:
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale")
-            tangent = eq.tangent()
-            lu, floor = _factorised(tangent[:, :n_free]), self.round_off(tangent)
+            tangent, lu, floor = self.linearised()
             rhs = residual - tangent[:, n_free:] @ known if iteration == 0 and len(known) else residual
             correction = lu.solve(rhs)
             if first_energy is None:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
             eq.move(np.concatenate([correction, known if iteration == 0 else np.zeros_like(known)]))
             eq.evaluate(t)
-            residual = eq.residual()[:n_free]
         raise AssertionError("unreachable")
 
     def reach(self, landing: float, length: float) -> tuple[NewtonStep, float]:

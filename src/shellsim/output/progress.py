@@ -13,6 +13,12 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from ..solver.run import Listener, Run
 
 
+def _static(run: Run) -> bool:
+    """Whether ``run`` is in a static solve: load steps taken, no time step estimated yet
+    (a preloaded run's explicit phase has one)."""
+    return bool(run.newton) and not run.dt
+
+
 class ProgressDisplay(Listener):
     def __init__(self, console: Console, end_time: float, quiet: bool = False):
         self.console = console
@@ -46,7 +52,7 @@ class ProgressDisplay(Listener):
                       "per unit of simulated time)")
 
     def _fields(self, run: Run) -> dict:
-        if run.newton and not run.dt:  # a static solve: its last load step in place of the time step
+        if _static(run):  # its last load step in place of the time step
             step = run.newton[-1]
             return {"t": f"{run.sim.state.t:.4g}", "dt": f"load step {len(run.newton)}", "rate": "-",
                     "balance": f"{step.iterations} iterations, residual {step.residual:.2g}",
@@ -67,7 +73,7 @@ class ProgressDisplay(Listener):
         elif run.sim.state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
             f = self._fields(run)
             done = f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
-            self.console.print(done + (f"{f['dt']}: {f['balance']}" if run.newton and not run.dt else
+            self.console.print(done + (f"{f['dt']}: {f['balance']}" if _static(run) else
                                        f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}, "
                                        f"worst J/J0 {f['quality']}"), highlight=False)
             self.next_line += 0.1

@@ -218,7 +218,8 @@ def _run_report(result: dict, folder: Path) -> Table | str:
     as written, never read as markup."""
     e = result["energy"]
     static = result.get("static")
-    caption = ((f"{static['load_steps']} load steps, {static['iterations']} Newton iterations, "
+    caption = ((f"{static['load_steps']} load steps, {static['iterations']} Newton iterations "
+                f"({static['tangents']} tangents), "
                 f"{static['cutbacks']} cut back, {result['wall_time_s']:.2f} s") if static else
                (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
                 f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
@@ -439,7 +440,7 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     if sv.method == "static":
         st = sv.static
         steps = ("arc-length steps along the path (the load found with the shape) until the clock passes"
-                 if st.control == "arc_length" else "Newton-Raphson load steps to")
+                 if st.control == "arc_length" else f"{st.newton} Newton-Raphson load steps to")
         table.add_row("solver", f"static: {steps} t = {sv.end_time}, {st.increments} "
                                 f"first, at most {st.max_iterations} iterations each, tolerances force "
                                 f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")

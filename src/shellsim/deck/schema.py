@@ -223,15 +223,21 @@ class Static(Section):
     and a load or prescribed motion without a curve grows linearly from 0 to its value over
     it. ``increments``: load steps to try first (more are taken where Newton needs them:
     a step that does not converge in ``max_iterations`` is cut to a quarter, one that
-    converges in a few iterations grows by half, down to ``min_increment`` of the span).
-    An iteration has converged when the residual force is within ``force_tolerance`` of
-    the largest of the external and internal force norms and the residual's work on the
-    correction within ``energy_tolerance`` of the step's first.
+    converges with a few tangents formed grows by half, down to ``min_increment`` of the
+    span). An iteration has converged when the residual force is within
+    ``force_tolerance`` of the largest of the external and internal force norms and the
+    residual's work on the correction within ``energy_tolerance`` of the step's first.
+    ``newton = "modified"`` keeps the last tangent (from earlier steps too) while each
+    iteration removes at least half of the residual and forms a new one where an
+    iteration does not (going back first when it made the residual larger): forming a
+    tangent costs about forty residuals, so this takes more iterations and less time.
+    ``"full"`` forms the tangent at every iteration (quadratic convergence).
 
     ``control = "arc_length"`` follows the equilibrium path through limit points instead
     (a snapping shell, a tube past its inflation maximum): each step moves the
     translations a fixed distance and finds the load time with the shape, so the load
-    may fall as well as rise. The first step is as long as the linear response to the
+    may fall as well as rise; it forms the tangent at every iteration. The first step is
+    as long as the linear response to the
     first of ``increments``; later steps grow or shrink with the iterations they take,
     to at most four times the first, and are cut to a quarter when they fail (down to
     ``min_increment`` of the first). The run's clock is then the load time's path length
@@ -239,8 +245,9 @@ class Static(Section):
     ``end_time``, and history.csv's load factors tell the load reached."""
 
     control: Literal["load", "arc_length"] = "load"
+    newton: Literal["modified", "full"] = "modified"
     increments: Count = 1
-    max_iterations: Count = 16
+    max_iterations: Count = 25
     force_tolerance: Positive = 1e-6
     energy_tolerance: Positive = 1e-12
     min_increment: Positive = 1e-6

@@ -55,7 +55,7 @@ class ProgressDisplay(Listener):
         if _static(run):  # its last load step in place of the time step
             step = run.newton[-1]
             return {"t": f"{run.sim.state.t:.4g}", "dt": f"load step {len(run.newton)}", "rate": "-",
-                    "balance": f"{step.iterations} iterations, residual {step.residual:.2g}",
+                    "balance": f"{step.iterations} iterations ({step.tangents} tangents), residual {step.residual:.2g}",
                     "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
         elapsed = max(time.perf_counter() - self.started, 1e-9)
         e = run.sim.state.energy

@@ -67,10 +67,11 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
 
 
 def static_record(run: Run) -> dict:
-    """A static solve's load steps: how many, the Newton iterations and cut-backs over them,
-    the largest relative residual a step ended with, and each step."""
+    """A static solve's load steps: how many, the Newton iterations, tangents formed and
+    cut-backs over them, the largest relative residual a step ended with, and each step."""
     steps = [vars(step) for step in run.newton]
     return {"load_steps": len(steps), "iterations": sum(s["iterations"] for s in steps),
+            "tangents": sum(s["tangents"] for s in steps),
             "cutbacks": sum(s["cutbacks"] for s in steps),
             "largest_residual": max((s["residual"] for s in steps), default=0.0), "steps": steps}
 

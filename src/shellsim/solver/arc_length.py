@@ -135,7 +135,7 @@ class ArcLength:
             try:
                 iterations, residual, change = self.step(length)
                 return NewtonStep(t=sim.state.t + abs(change), load_time=self.load_time, iterations=iterations,
-                                  residual=residual, cutbacks=cutbacks), length
+                                  tangents=iterations, residual=residual, cutbacks=cutbacks), length
             except NotConverged as why:
                 self.eq.converged.restore(sim)
                 cutbacks += 1

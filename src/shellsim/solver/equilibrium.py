@@ -19,6 +19,7 @@ from ..element.stress_update import INCREMENTAL, TOTAL
 from ..element.tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
 from ..curve_tables import factor
+from ..loads.edge_pressure import edge_pressure_tangents
 from ..loads.pressure import pressure_tangents
 from . import explicit
 from .simulation import Simulation
@@ -56,12 +57,15 @@ class Equilibrium:
         self.step_u = STEP_SHARE * size
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self.pressure_k = np.zeros((len(model.loads.pressure.elements), ELEMENT_DOFS, ELEMENT_DOFS))
+        self._edge_slots = _edge_slots(model)
+        self.edge_k = np.zeros((len(model.loads.edge_pressure.edges), 9, 15))
         self.moment_nodes = np.flatnonzero(np.abs(model.loads.moment.vectors).sum(axis=(0, 2)) > 0)
         # each moment node's first slot e * 9 + a: its diagonal block in element e takes the moment's stiffness
         self._moment_slots = model.body.slots[model.body.node_slots[self.moment_nodes]]
         self._t = 0.0
         self._tangents = TypedCall(element_tangents)
         self._pressure_tangents = TypedCall(pressure_tangents)
+        self._edge_tangents = TypedCall(edge_pressure_tangents)
         self._forces = TypedCall(explicit.forces)
         self._pattern()
 
@@ -152,6 +156,10 @@ class Equilibrium:
             self._pressure_tangents(model.rule, model.conn, s.fields.shape, pressure, space.scale_pressure,
                                     self.step_u, STEP_ROTATION, self.pressure_k)
             np.subtract.at(k, pressure.elements, self.pressure_k)
+        if len(self.edge_k):
+            self._edge_tangents(s.fields.shape, model.loads.edge_pressure, space.scale_edges, self.step_u,
+                                STEP_ROTATION, self.edge_k)
+            np.subtract.at(k, self._edge_slots, self.edge_k)
         if len(self.moment_nodes):
             self._add_moment_stiffness(k)
         if self._turned:
@@ -184,3 +192,19 @@ class Equilibrium:
         for slot, b in zip(self._moment_slots, block):
             e, a = divmod(int(slot), 9)
             k[e, 5 * a + 3:5 * a + 5, 5 * a + 3:5 * a + 5] += b
+
+
+def _edge_slots(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where each pressure-loaded edge's tangent (E, 9, 15) goes in the elements' (ne, 45,
+    45): an element holding its three nodes, and the rows of their forces and the columns
+    of their DOFs in it, as an index of k."""
+    edges = model.loads.edge_pressure.edges
+    element = np.empty(len(edges), dtype=np.int64)
+    local = np.empty((len(edges), 3), dtype=np.int64)
+    for m, nodes in enumerate(edges):
+        e = np.flatnonzero(np.isin(model.conn, nodes).sum(axis=1) == 3)[0]
+        element[m] = e
+        local[m] = [int(np.flatnonzero(model.conn[e] == node)[0]) for node in nodes]
+    rows = (5 * local[:, :, None] + np.arange(3)).reshape(len(edges), 9)
+    cols = (5 * local[:, :, None] + np.arange(5)).reshape(len(edges), 15)
+    return element[:, None, None], rows[:, :, None], cols[:, None, :]

@@ -4,9 +4,10 @@ step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`.
 
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
 turns to no number, or whose tangent is singular) is taken again from the last converged
-state at a quarter of its length; one that converges within GROWTH_ITERATIONS iterations
-lets the next grow by half, up to the deck's first length. The outputs are the explicit
-run's: a history sample at every converged step, frames at the output times.
+state at a quarter of its length; one that converges with at most GROWTH_TANGENTS
+tangents formed lets the next grow by half, up to the deck's first length. The outputs
+are the explicit run's: a history sample at every converged step, frames at the output
+times.
 """
 
 from __future__ import annotations
@@ -21,18 +22,21 @@ from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, _frame, _record, ending, output_times
 
-CUT, GROW, GROWTH_ITERATIONS = 0.25, 1.5, 4
+CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
+#: Modified Newton forms a new tangent when an iteration leaves more than this share of the residual.
+SLOW = 0.5
 
 
 @dataclass
 class NewtonStep:
     """A converged load step: the run's clock t at its end and the load time it reached
-    (the same under load control), the iterations it took, the relative residual it
-    ended with, and the tries cut back before it converged."""
+    (the same under load control), the iterations it took and the tangents it formed for
+    them, the relative residual it ended with, and the tries cut back before it converged."""
 
     t: float
     load_time: float
     iterations: int
+    tangents: int
     residual: float
     cutbacks: int
 
@@ -60,6 +64,8 @@ class NewtonSolver:
         self.n_free = self.eq.unknowns.n_free
         self.last_residual = np.zeros(self.n_free)
         self.extent = float(np.abs(run.model.x0).max())
+        #: (tangent, its free columns' LU, round-off floor) the iterations use, None until the first
+        self.tangent = None
 
     def round_off(self, tangent) -> float:
         """The residual's round-off floor at a tangent (n_free, size): machine epsilon times
@@ -94,32 +100,48 @@ class NewtonSolver:
 
     def step(self, t: float) -> tuple[int, float]:
         """Equilibrium at load time t from the converged state; returns (iterations,
-        relative residual). Raises NotConverged with the reason."""
+        tangents formed, relative residual). Raises NotConverged with the reason.
+
+        Full Newton forms the tangent at every iterate. Modified Newton keeps the last one
+        (from earlier steps too) while each iteration leaves at most SLOW of the residual;
+        when one leaves more it forms a new tangent there, or, when that iteration made the
+        residual larger, goes back to the iterate before it and forms the tangent there."""
         eq, settings, n_free = self.eq, self.settings, self.n_free
         eq.evaluate(t)
         known = eq.prescribed_increments(t)
-        first_energy = None
-        lu, floor = None, 0.0
+        pending = known  # the prescribed moves, made with the first correction
+        first_energy, previous, before, tangents = None, np.inf, None, 0
         for iteration in range(settings.max_iterations + 1):
             residual = self.free_residual()
             scale = eq.force_scale()
             norm = float(np.linalg.norm(residual))
             if iteration == 0 and not np.any(known) and norm <= settings.force_tolerance * scale:
-                return 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
+                return 0, 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
             if iteration > 0:
                 # the energy of the next correction, with the last factorisation
-                energy = abs(float(lu.solve(residual) @ residual))
-                if self.converged(norm, scale, energy, first_energy, floor):
-                    return iteration, norm / max(scale, 1e-300)
+                energy = abs(float(self.tangent[1].solve(residual) @ residual))
+                if self.converged(norm, scale, energy, first_energy, self.tangent[2]):
+                    return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale")
-            tangent, lu, floor = self.linearised()
-            rhs = residual - tangent[:, n_free:] @ known if iteration == 0 and len(known) else residual
+            if self.tangent is None or settings.newton == "full" or norm > SLOW * previous:
+                if before is not None and norm > previous:  # an old tangent led away: undo its correction
+                    (before_state, pending, residual, norm) = before
+                    before_state.restore(self.run.sim)
+                    eq.evaluate(t)
+                self.tangent, before = self.linearised(), None
+                tangents += 1
+            else:
+                before = (Converged(self.run.sim), pending, residual, norm)
+            previous = norm
+            tangent, lu, _ = self.tangent
+            rhs = residual - tangent[:, n_free:] @ pending if np.any(pending) else residual
             correction = lu.solve(rhs)
             if first_energy is None:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
-            eq.move(np.concatenate([correction, known if iteration == 0 else np.zeros_like(known)]))
+            eq.move(np.concatenate([correction, pending]))
+            pending = np.zeros_like(known)
             eq.evaluate(t)
         raise AssertionError("unreachable")
 
@@ -134,12 +156,14 @@ class NewtonSolver:
             remaining = landing - sim.state.t
             target = landing if remaining <= 1.25 * length else sim.state.t + length
             try:
-                iterations, residual = self.step(target)
-                step = NewtonStep(t=target, load_time=target, iterations=iterations, residual=residual,
+                iterations, tangents, residual = self.step(target)
+                step = NewtonStep(t=target, load_time=target, iterations=iterations, tangents=tangents,
+                                  residual=residual,
                                   cutbacks=cutbacks)
                 return step, length
             except NotConverged as why:
                 self.eq.converged.restore(sim)
+                self.tangent = None  # it may have been formed far from the path
                 cutbacks += 1
                 length = min(length, remaining) * CUT
                 if length < self.settings.min_increment * end:
@@ -192,7 +216,7 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
             sim.state.t = step.t
             newton.commit(step)
             _record(run, listener)
-            if step.iterations <= GROWTH_ITERATIONS and step.cutbacks == 0:
+            if step.tangents <= GROWTH_TANGENTS and step.cutbacks == 0:
                 length = min(length * GROW, largest)
         _frame(run, listener)
 

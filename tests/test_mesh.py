@@ -7,6 +7,8 @@ import math
 import signal
 import threading
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -263,6 +265,65 @@ def test_gmsh_msh_file_with_physical_groups_imports_with_its_sets(tmp_path):
     assert np.allclose(on(mesh, "left")[:, 0], 0.0) and len(mesh.sets["left"].edges) == 2
     np.testing.assert_allclose(on(mesh, "corner"), [[2.0, 1.0, 0.0]])
     np.testing.assert_allclose(mesh.director, np.tile([0, 0, 1.0], (mesh.n_nodes, 1)), atol=1e-12)
+
+
+def _two_patch_plate(path: Path, groups, version: float = 4.1) -> None:
+    """A 2 x 1 plate of two square surfaces, 2 x 2 quad9 each, written to ``path`` in
+    gmsh's file format ``version`` with physical ``groups``: (dimension, name, which)
+    where which picks entities from the points, lines and surfaces."""
+    with gmsh_session() as gmsh:
+        gmsh.option.setNumber("Mesh.MshFileVersion", version)
+        geo = gmsh.model.geo
+        p = [geo.addPoint(x, y, 0) for x, y in ((0, 0), (1, 0), (2, 0), (2, 1), (1, 1), (0, 1))]
+        lines = [geo.addLine(p[i], p[(i + 1) % 6]) for i in range(6)] + [geo.addLine(p[1], p[4])]
+        loops = [[lines[0], lines[6], lines[4], lines[5]], [lines[1], lines[2], lines[3], -lines[6]]]
+        surfaces = [geo.addPlaneSurface([geo.addCurveLoop(loop)]) for loop in loops]
+        for line in lines:
+            geo.mesh.setTransfiniteCurve(abs(line), 3)
+        for surface in surfaces:
+            geo.mesh.setTransfiniteSurface(surface)
+            geo.mesh.setRecombine(2, surface)
+        geo.synchronize()
+        entities = {0: p, 1: lines, 2: surfaces}
+        for dim, name, which in groups:
+            gmsh.model.addPhysicalGroup(dim, [entities[dim][i] for i in which], name=name)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(2)
+        gmsh.write(str(path))
+
+
+@pytest.mark.parametrize("version", [4.1, 2.2])
+def test_a_physical_group_over_several_entities_keeps_all_of_them(tmp_path, version):
+    """Groups spanning two surfaces, two lines and two points, in gmsh's two file formats:
+    every element and node of every entity is in the set (one block per entity used to
+    leave only the last)."""
+    path = tmp_path / "plate.msh"
+    _two_patch_plate(path, [(2, "plate", [0, 1]), (1, "bottom", [0, 1]), (0, "ends", [0, 2])], version)
+    _, mesh = build('builder = "file"\npath = "' + str(path) + '"')
+    assert mesh.n_elements == 8
+    np.testing.assert_array_equal(np.sort(mesh.sets["plate"].elements), np.arange(8))
+    bottom = on(mesh, "bottom")
+    assert len(bottom) == 9 and np.allclose(bottom[:, 1], 0.0) and len(mesh.sets["bottom"].edges) == 4
+    np.testing.assert_allclose(np.sort(bottom[:, 0]), np.linspace(0.0, 2.0, 9), atol=1e-12)
+    np.testing.assert_allclose(on(mesh, "ends")[np.argsort(on(mesh, "ends")[:, 0])], [[0, 0, 0], [2, 0, 0]],
+                               atol=1e-12)
+
+
+def test_one_name_on_cells_of_two_kinds_is_refused(tmp_path, monkeypatch):
+    """A cell set over quad9 cells and lines (gmsh's files cannot say it, but a meshio
+    mesh can) is not a set of one kind: refused with the name."""
+    import meshio
+
+    from shellsim.geometry import importing
+
+    path = tmp_path / "plate.msh"
+    _two_patch_plate(path, [(2, "plate", [0, 1])])
+    m = meshio.read(path)
+    m.cells.append(meshio.CellBlock("line3", np.array([[0, 1, 4]])))
+    m.cell_sets = {"left": [np.array([0])] * (len(m.cells) - 1) + [np.array([0])]}
+    monkeypatch.setattr(importing, "_read", lambda _: m)
+    with pytest.raises(MeshError, match=r"plate.msh': the name 'left' is given to edge and surface cells"):
+        build('builder = "file"\npath = "' + str(path) + '"')
 
 
 def test_a_file_without_quad9_is_refused_with_what_it_holds(tmp_path):

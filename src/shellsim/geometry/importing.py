@@ -2,8 +2,9 @@
 quadrilaterals (``quad9``; node order as gmsh and VTK, which is the element's).
 
 Named sets come from
-- cell sets (gmsh physical groups): on quad9 cells a surface set, on 3-node lines an edge
-  set, on vertices a point set;
+- cell sets (gmsh physical groups, in the 2.2 and 4.x formats; a group over several
+  entities is merged): on quad9 cells a surface set, on 3-node lines an edge set, on
+  vertices a point set;
 - point-data arrays ``set_<name>`` (nonzero = member; 1 point, 2 edge, 3 surface set), as
   :func:`shellsim.output.mesh_files.write_mesh_vtu` writes them.
 Point data ``director`` (n, 3) and ``thickness`` (n,) are used when present.
@@ -30,6 +31,7 @@ SET_PREFIX = "set_"
 KIND_CODE = {"point": 1, "edge": 2, "surface": 3}
 _KIND_OF_CODE = {v: k for k, v in KIND_CODE.items()}
 _KIND_OF_CELL = {"quad9": "surface", "line3": "edge", "line": "edge", "vertex": "point"}
+_DIMENSION = {"quad9": 2, "line3": 1, "line": 1, "vertex": 0}
 #: Surface and volume cells other than quad9: a file holding them is not a quad9 shell mesh.
 _NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", "tetra", "tetra10", "hexahedron",
               "hexahedron20", "hexahedron27", "wedge", "pyramid"}
@@ -113,23 +115,7 @@ def read_mesh(path: Path) -> ImportedMesh:
     if director is not None:  # within the tolerance of unit length: made exactly unit
         director = director / np.linalg.norm(director, axis=1, keepdims=True)
 
-    sets: dict[str, NamedSet] = {}
-    for name, per_block in m.cell_sets.items():
-        if name.startswith("gmsh:"):
-            continue
-        for b, (block, cells) in enumerate(zip(m.cells, per_block)):
-            kind = _KIND_OF_CELL.get(block.type)
-            if kind is None or cells is None or len(cells) == 0:
-                continue
-            cells = np.asarray(cells, dtype=np.int64)  # meshio may give uint64
-            if kind == "surface":
-                k = blocks.index(b)
-                elements = offsets[k] + cells
-                sets[name] = NamedSet("surface", np.unique(conn[elements]), elements=elements)
-            else:
-                nodes = index[np.asarray(block.data[cells])]
-                nodes = nodes[(nodes >= 0).all(axis=-1)] if nodes.ndim > 1 else nodes[nodes >= 0]
-                sets[name] = _node_set(kind, np.unique(nodes), conn)
+    sets = _cell_sets(path, m, blocks, offsets, index, conn)
     for key in m.point_data:
         if key.startswith(SET_PREFIX):
             values = np.nan_to_num(point_array(key, None))
@@ -138,6 +124,50 @@ def read_mesh(path: Path) -> ImportedMesh:
                 sets[key[len(SET_PREFIX):]] = _node_set(_KIND_OF_CODE[code], np.flatnonzero(values), conn)
 
     return ImportedMesh(x, conn, sets, director, thickness)
+
+
+def _cell_sets(path: Path, m, blocks: list[int], offsets: np.ndarray, index: np.ndarray,
+               conn: np.ndarray) -> dict[str, NamedSet]:
+    """The named sets of the file's cell sets. A gmsh physical group over several entities
+    (an edge of two curves, a surface of four patches) comes as one block per entity:
+    their members are merged under the name. ``blocks`` are the quad9 blocks, ``offsets``
+    their first elements, ``index`` a file node's number among the kept nodes (-1: unused)."""
+    members: dict[str, dict[str, list[np.ndarray]]] = {}
+    for name, per_block in _named_cells(m).items():
+        for b, (block, cells) in enumerate(zip(m.cells, per_block)):
+            kind = _KIND_OF_CELL.get(block.type)
+            if kind is None or cells is None or len(cells) == 0:
+                continue
+            cells = np.asarray(cells, dtype=np.int64)  # meshio may give uint64
+            if kind == "surface":
+                found = offsets[blocks.index(b)] + cells
+            else:
+                nodes = index[np.asarray(block.data[cells])]
+                found = nodes[(nodes >= 0).all(axis=-1)] if nodes.ndim > 1 else nodes[nodes >= 0]
+            members.setdefault(name, {}).setdefault(kind, []).append(found.ravel())
+    sets: dict[str, NamedSet] = {}
+    for name, kinds in members.items():
+        if len(kinds) > 1:
+            raise MeshError(f"mesh file '{path}': the name '{name}' is given to {' and '.join(sorted(kinds))} "
+                            "cells; a set is one kind (points, edges or a surface): give each group its own name")
+        (kind, parts), = kinds.items()
+        found = np.unique(np.concatenate(parts))
+        sets[name] = (NamedSet("surface", np.unique(conn[found]), elements=found) if kind == "surface"
+                      else _node_set(kind, found, conn))
+    return sets
+
+
+def _named_cells(m) -> dict[str, list[np.ndarray]]:
+    """Each cell set's cells in every block of the meshio mesh ``m``. meshio gives gmsh's
+    4.x physical groups as cell sets, but its 2.2 format only as a physical tag per cell
+    and the groups' (tag, dimension) by name: the sets are then made from those."""
+    named = {name: cells for name, cells in m.cell_sets.items() if not name.startswith("gmsh:")}
+    tags = m.cell_data.get("gmsh:physical")
+    if named or tags is None:
+        return named
+    return {name: [np.flatnonzero(np.asarray(block_tags) == tag) if _DIMENSION.get(block.type) == dim else None
+                   for block, block_tags in zip(m.cells, tags)]
+            for name, (tag, dim) in ((name, values[:2]) for name, values in m.field_data.items())}
 
 
 def _refuse(path: Path, problems: list[str]) -> None:

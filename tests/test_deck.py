@@ -137,6 +137,66 @@ def test_linear_extrapolation_continues_the_end_segments():
     np.testing.assert_allclose(curve(np.array([-1.0, 2.0])), [-1.0, 5.0])
 
 
+WAVEFORM = """# aortic pressure, one beat
+time_ms, pressure_mmHg
+0, 80
+100, 118
+300, 120
+500, 95
+800, 80
+"""
+
+
+def _waveform_deck(tmp_path, curve: str) -> str:
+    (tmp_path / "beat.csv").write_text(WAVEFORM)
+    deck = deck_text(RECTANGLE, '[[boundary]]\ntype = "clamped"\nset = "x0"\n[[load]]\ntype = "pressure"\n'
+                                'set = "all"\nvalue = 133.322\ncurve = "beat"\n[curves.beat]\n' + curve)
+    (tmp_path / "deck.toml").write_text(deck)
+    return str(tmp_path / "deck.toml")
+
+
+def test_a_waveform_from_a_csv_file_repeats_in_the_decks_units(tmp_path):
+    """A beat in ms and mmHg, repeated three times into an SI deck: the table's points
+    land at their scaled times in every cycle, in between it interpolates, after the last
+    cycle it holds; the resolved deck holds the table itself and loads to the same curve."""
+    from shellsim.deck.resolved import resolved_text
+
+    deck = load_deck(_waveform_deck(tmp_path, 'file = "beat.csv"\ntime_scale = 0.001\nrepeat = 3\n'))
+    curve = deck.curves["beat"]
+    beat = np.array([[0, 80], [0.1, 118], [0.3, 120], [0.5, 95], [0.8, 80]])
+    for cycle in range(3):
+        np.testing.assert_allclose(curve(beat[:, 0] + 0.8 * cycle), beat[:, 1])
+    assert curve(0.8 + 0.05) == pytest.approx(99.0) and curve(5.0) == 80.0
+    assert len(curve.table()[0]) == 13  # the cycles share their end points
+    again = parse_deck(resolved_text(deck, tmp_path / "deck.toml", "test")).curves["beat"]
+    assert again.file is None
+    np.testing.assert_array_equal(again.table()[0], curve.table()[0])
+
+
+def test_a_period_longer_than_the_table_leaves_a_gap_it_interpolates(tmp_path):
+    curve = Curve(t=[0.0, 0.5], value=[0.0, 1.0], repeat=2, period=1.0)
+    np.testing.assert_allclose(curve(np.array([0.5, 0.75, 1.0, 1.5, 2.0])), [1.0, 0.5, 0.0, 1.0, 1.0])
+
+
+@pytest.mark.parametrize(("curve", "csv", "expected"), [
+    ('file = "gone.csv"\n', None, ["curves.beat.file", "gone.csv' not found"]),
+    ('file = "beat.csv"\n', "t,p\n0,1\n1,2\n1,3\n", ["beat.csv' line 4", "strictly increasing", "1 follows 1"]),
+    ('file = "beat.csv"\n', "t,p\n0,1\n1,abc\n", ["beat.csv' line 3", "expected a time and a value", "1,abc"]),
+    ('file = "beat.csv"\n', "t,p\n", ["beat.csv' holds no (time, value) rows"]),
+    ('file = "beat.csv"\nt = [0.0, 1.0]\n', None, ["curves.beat", "either as 't' and 'value' or as 'file'"]),
+    ('file = "beat.csv"\nperiod = 0.5\n', None, ["curves.beat.file", "'period' = 0.5 is shorter", "800"]),
+    ('t = [0.0, 1.0]\n', None, ["curves.beat", "needs 't' and 'value'"]),
+])
+def test_a_waveform_that_cannot_be_used_names_the_file_line_and_key(tmp_path, curve, csv, expected):
+    path = _waveform_deck(tmp_path, curve)
+    if csv is not None:
+        (tmp_path / "beat.csv").write_text(csv)
+    with pytest.raises(DeckError) as caught:
+        load_deck(path)
+    for part in expected:
+        assert part in str(caught.value), str(caught.value)
+
+
 # --- no input ever ends in a traceback -------------------------------------------------
 
 VALID = tomllib.loads(deck_text(

@@ -1,34 +1,52 @@
-"""Time curves: tables of (time, factor), never expressions. Loads and prescribed motions
-are ``value * curve(t)``."""
+"""Time curves: tables of (time, factor), given in the deck or read from a CSV file,
+repeated for periodic loads, never expressions. Loads and prescribed motions are
+``value * curve(t)``."""
 
 from __future__ import annotations
 
+import re
+from pathlib import Path
 from typing import Literal
 
 import numpy as np
 from pydantic import field_validator, model_validator
 
 from ..curve_tables import EXTRAPOLATION, INTERPOLATION, curve_value
-from .types import Real, Section
+from .types import Count, Positive, Real, Section
 
 
 class Curve(Section):
-    """A tabulated factor of time.
+    """A tabulated factor of time: ``t`` and ``value``, or ``file``.
 
     ``interpolate``: ``linear`` between points, ``step`` (holds the value of the last point
     passed) or ``smooth`` (cubic with zero slope at every point, so a ramp starts and ends
     without a jolt). ``extrapolate``: beyond the table, ``constant`` holds the end values,
     ``linear`` continues the end segments.
+
+    ``file``: a CSV file of (time, value) rows (a path relative to the deck; header lines
+    and ``#`` comments are skipped), its times multiplied by ``time_scale`` and its values
+    by ``value_scale`` into the deck's units (a file in ms into an SI deck takes
+    ``time_scale = 0.001``; a pressure in mmHg is a factor of a load of ``value =
+    133.322`` Pa). ``repeat``: the table's cycles end to end, a waveform over several
+    beats; a cycle lasts ``period``, by default the table's span (its last point is then
+    the next cycle's first).
     """
 
-    t: list[Real]
-    value: list[Real]
+    t: list[Real] | None = None
+    value: list[Real] | None = None
+    file: str | None = None
+    time_scale: Positive = 1.0
+    value_scale: Real = 1.0
     interpolate: Literal["linear", "step", "smooth"] = "linear"
     extrapolate: Literal["constant", "linear"] = "constant"
+    repeat: Count = 1
+    period: Positive | None = None
 
     @field_validator("t")
     @classmethod
-    def _increasing(cls, t: list[float]) -> list[float]:
+    def _increasing(cls, t: list[float] | None) -> list[float] | None:
+        if t is None:
+            return t
         if len(t) < 1:
             raise ValueError("needs at least one point")
         steps = np.diff(t)
@@ -41,12 +59,21 @@ class Curve(Section):
         return t
 
     @model_validator(mode="after")
-    def _same_length(self) -> "Curve":
+    def _one_table(self) -> "Curve":
+        if self.file is not None:
+            if self.t is not None or self.value is not None:
+                raise ValueError("give the table either as 't' and 'value' or as 'file', not both")
+            return self
+        if self.t is None or self.value is None:
+            raise ValueError("needs 't' and 'value' (one value per time), or 'file' (a CSV of time, value rows)")
         if len(self.value) != len(self.t):
             raise ValueError(
                 f"'value' has {len(self.value)} entries but 't' has {len(self.t)}; "
                 "give one value per time"
             )
+        if self.period is not None and self.period < self.t[-1] - self.t[0]:
+            raise ValueError(f"'period' = {self.period} is shorter than the table's span, "
+                             f"{self.t[-1] - self.t[0]:g}: one cycle would overlap the next")
         return self
 
     def __call__(self, time: float | np.ndarray) -> float | np.ndarray:
@@ -57,6 +84,62 @@ class Curve(Section):
         return out if x.ndim else float(out)
 
     def table(self) -> tuple[np.ndarray, np.ndarray, int, int]:
-        """(times, values, interpolation code, extrapolation code) for :func:`curve_value`."""
-        return (np.asarray(self.t, dtype=float), np.asarray(self.value, dtype=float),
-                INTERPOLATION[self.interpolate], EXTRAPOLATION[self.extrapolate])
+        """(times, values, interpolation code, extrapolation code) for :func:`curve_value`,
+        the cycles repeated. Only for a curve with its table (a file's is read by
+        :func:`with_file_tables`)."""
+        t, v = np.asarray(self.t, dtype=float), np.asarray(self.value, dtype=float)
+        period = self.period if self.period is not None else t[-1] - t[0]
+        if self.repeat > 1 and period > 0:
+            joined = period == t[-1] - t[0]  # the last point is the next cycle's first
+            later_t, later_v = (t[1:], v[1:]) if joined else (t, v)
+            t = np.concatenate([t] + [later_t + k * period for k in range(1, self.repeat)])
+            v = np.concatenate([v] + [later_v] * (self.repeat - 1))
+        return t, v, INTERPOLATION[self.interpolate], EXTRAPOLATION[self.extrapolate]
+
+
+def with_file_tables(curve: Curve, base_dir: Path | None) -> Curve:
+    """``curve`` with its file's table in place of the file (times and values scaled, the
+    scales then 1), so the resolved deck holds it; a curve without a file as it is.
+    Raises ValueError naming the file, the line and what was expected."""
+    if curve.file is None:
+        return curve
+    path = Path(curve.file)
+    path = path if path.is_absolute() or base_dir is None else base_dir / path
+    t, value = read_table(path)
+    data = curve.model_dump(exclude={"file", "time_scale", "value_scale"}, exclude_none=True)
+    data.update(t=[curve.time_scale * x for x in t], value=[curve.value_scale * x for x in value])
+    return Curve.model_validate(data)
+
+
+def read_table(path: Path) -> tuple[list[float], list[float]]:
+    """The (time, value) rows of a CSV file: comma, semicolon, tab or space separated, the
+    first two columns; lines before the first row of numbers (a header) and ``#``
+    comments skipped. Raises ValueError naming the file and line."""
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except FileNotFoundError:
+        raise ValueError(f"file '{path}' not found") from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise ValueError(f"file '{path}' cannot be read: {getattr(error, 'strerror', None) or error}") from None
+    t: list[float] = []
+    value: list[float] = []
+    for number, line in enumerate(lines, start=1):
+        fields = [f for f in re.split(r"[,;\s]+", line.split("#")[0].strip()) if f]
+        if not fields:
+            continue
+        try:
+            row = [float(f) for f in fields[:2]]
+        except ValueError:
+            row = []
+        if len(row) < 2 or not all(np.isfinite(row)):
+            if not t:
+                continue  # a header
+            raise ValueError(f"file '{path}' line {number}: expected a time and a value, found '{line.strip()}'")
+        if t and row[0] <= t[-1]:
+            raise ValueError(f"file '{path}' line {number}: times must be strictly increasing, but "
+                             f"{row[0]:g} follows {t[-1]:g}")
+        t.append(row[0])
+        value.append(row[1])
+    if not t:
+        raise ValueError(f"file '{path}' holds no (time, value) rows")
+    return t, value

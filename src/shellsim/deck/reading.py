@@ -11,6 +11,7 @@ from pydantic import ValidationError
 
 from ..errors import DeckError
 from .messages import format_errors
+from .curves import with_file_tables
 from .references import check_references
 from .schema import Deck
 
@@ -46,11 +47,29 @@ def deck_from_data(data: dict, name: str = "<deck>", base_dir: Path | None = Non
         deck = Deck.model_validate(data)
     except ValidationError as err:
         raise DeckError(name, format_errors(err, data, text, Deck)) from None
+    deck = _curve_files_read(deck, name, base_dir)
     builder_sets = deck.geometry.sets() if deck.geometry.builder != "file" else None
     problems = check_references(deck, builder_sets)
     if problems:
         raise DeckError(name, problems)
     return deck
+
+
+def _curve_files_read(deck: Deck, name: str, base_dir: Path | None) -> Deck:
+    """``deck`` with the tables of its curves' files in place (:func:`with_file_tables`);
+    DeckError naming every file that cannot be used."""
+    curves, problems = {}, []
+    for key, curve in deck.curves.items():
+        try:
+            curves[key] = with_file_tables(curve, base_dir)
+        except ValueError as error:
+            problems.append(f"curves.{key}.file: {error}")
+        except ValidationError as error:
+            problems += [f"curves.{key}.file '{curve.file}': {e['msg'].removeprefix('Value error, ')}"
+                         for e in error.errors()]
+    if problems:
+        raise DeckError(name, problems)
+    return deck.model_copy(update={"curves": curves})
 
 
 def resolve_mesh_path(deck: Deck, base_dir: Path | None) -> Path:

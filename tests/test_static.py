@@ -83,6 +83,9 @@ PATHS = {
     "Mooney-Rivlin": ('model = "mooney_rivlin"\nC1 = 150.0\nC2 = 50.0\ndensity = 1.0', HELD, 0.02, 0.01),
     "Guccione": ('model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\ndensity = 1.0\n'
                  'axes = { kind = "cylindrical", axis = [0.0, 1.0, 0.0] }', HELD, 0.02, 0.01),
+    "Holzapfel-Gasser-Ogden": ('model = "hgo"\nmu = 100.0\nk1 = 200.0\nk2 = 2.0\nkappa = 0.1\nbeta_deg = 40.0\n'
+                               'density = 1.0\naxes = { kind = "cylindrical", axis = [0.0, 1.0, 0.0] }', HELD, 0.02,
+                               0.01),
 }
 
 

@@ -19,10 +19,10 @@ from __future__ import annotations
 from numba import njit
 
 from ..deck.types import tag_of
-from . import guccione, mooney_rivlin, st_venant_kirchhoff
+from . import guccione, hgo, mooney_rivlin, st_venant_kirchhoff
 
 #: The laws, in the order of their codes.
-LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff)
+LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff, hgo)
 
 
 def law_of(model: str):

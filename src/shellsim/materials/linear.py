@@ -38,7 +38,7 @@ class LinearElastic(Section):
         if not -1.0 < nu < 0.5:
             raise ValueError(
                 f"a compressible model needs -1 < nu < 0.5, got {nu}; for incompressible "
-                "tissue use model = 'neo_hookean', 'mooney_rivlin' or 'guccione'"
+                "tissue use model = 'neo_hookean', 'mooney_rivlin', 'guccione' or 'hgo'"
             )
         return nu
 

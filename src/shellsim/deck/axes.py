@@ -1,10 +1,11 @@
-"""Material axes of an anisotropic law: how the fibre direction is laid on the lamina."""
+"""Material axes of an anisotropic law: how the fibre direction is laid on the lamina, and
+the base of the laws' deck tables."""
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union
 
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
 from .types import Section, Vec3
 
@@ -42,3 +43,19 @@ def _nonzero_vector(v: tuple[float, float, float]) -> tuple[float, float, float]
     if sum(c * c for c in v) == 0.0:
         raise ValueError("must not be the zero vector")
     return v
+
+
+class AnisotropicLaw(Section):
+    """The base of an anisotropic hyperelastic law's ``[material]`` table, which declares
+    ``axes: Axes`` among its own fields: cylindrical axes when the deck gives none."""
+
+    HYPERELASTIC: ClassVar[bool] = True
+    ANISOTROPIC: ClassVar[bool] = True
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_axes(cls, data: object) -> object:
+        # A vessel is the common case; state the default so the resolved deck shows it.
+        if isinstance(data, dict) and "axes" not in data:
+            return data | {"axes": {"kind": "cylindrical"}}
+        return data

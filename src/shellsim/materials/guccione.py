@@ -15,19 +15,17 @@ element group (:mod:`shellsim.element.lanes`).
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal
+from typing import Literal
 
 import numpy as np
 from numba import njit
-from pydantic import model_validator
 
-from ..deck.axes import Axes
-from ..deck.types import Positive, Section
+from ..deck.axes import AnisotropicLaw, Axes
+from ..deck.types import Positive
 from ..element.lanes import LANES
 
 
-
-class Guccione(Section):
+class Guccione(AnisotropicLaw):
     """Incompressible Guccione (thesis Eq 4.2): W = C1/2 (exp Q - 1),
     Q = C2 E11^2 + C3 (E22^2 + E33^2 + 2 E23^2) + C4 (2 E12^2 + 2 E13^2)
     in material axes (1 = fibre, e.g. circumferential; 2 = cross-fibre; 3 = normal)."""
@@ -39,16 +37,6 @@ class Guccione(Section):
     C4: Positive
     density: Positive
     axes: Axes
-    HYPERELASTIC: ClassVar[bool] = True
-    ANISOTROPIC: ClassVar[bool] = True
-
-    @model_validator(mode="before")
-    @classmethod
-    def _default_axes(cls, data: object) -> object:
-        # A tube is the common case; state the default so the resolved deck shows it.
-        if isinstance(data, dict) and "axes" not in data:
-            return data | {"axes": {"kind": "cylindrical"}}
-        return data
 
 
 INCOMPRESSIBLE = True

@@ -21,18 +21,18 @@ strain per lane of an element group (:mod:`shellsim.element.lanes`).
 from __future__ import annotations
 
 import math
-from typing import ClassVar, Literal
+from typing import Literal
 
 import numpy as np
 from numba import njit
 from pydantic import Field, model_validator
 
-from ..deck.axes import Axes
-from ..deck.types import NonNegative, Positive, Real, Section
+from ..deck.axes import AnisotropicLaw, Axes
+from ..deck.types import NonNegative, Positive, Real
 from ..element.lanes import LANES
 
 
-class HolzapfelGasserOgden(Section):
+class HolzapfelGasserOgden(AnisotropicLaw):
     """Incompressible Holzapfel-Gasser-Ogden with fibre dispersion (Gasser, Ogden &
     Holzapfel 2006): W = mu/2 (I1 - 3) + sum over the two families k1/(2 k2)
     (exp(k2 Ebar^2) - 1), Ebar = kappa (I1 - 3) + (1 - 3 kappa) (I4 - 1); the families at
@@ -48,16 +48,6 @@ class HolzapfelGasserOgden(Section):
     beta_deg: Real = Field(ge=0.0, le=90.0)
     density: Positive
     axes: Axes
-    HYPERELASTIC: ClassVar[bool] = True
-    ANISOTROPIC: ClassVar[bool] = True
-
-    @model_validator(mode="before")
-    @classmethod
-    def _default_axes(cls, data: object) -> object:
-        # A vessel is the common case; state the default so the resolved deck shows it.
-        if isinstance(data, dict) and "axes" not in data:
-            return data | {"axes": {"kind": "cylindrical"}}
-        return data
 
     @model_validator(mode="after")
     def _dispersion(self) -> "HolzapfelGasserOgden":
@@ -79,7 +69,8 @@ def parameters(material) -> np.ndarray:
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _structure(params, family, H):
-    """H (3, 3) = kappa I + (1 - 3 kappa) a a of fibre family 0 (+beta) or 1 (-beta)."""
+    """H (3, 3) = kappa I + (1 - 3 kappa) a a of fibre family 0 (+beta) or 1 (-beta);
+    returns the family's direction a = (a0, a1, 0) as (a0, a1)."""
     kappa = params[3]
     a0, a1 = params[4], params[5] if family == 0 else -params[5]
     H[:] = 0.0
@@ -89,12 +80,13 @@ def _structure(params, family, H):
     H[1, 1] += (1.0 - 3.0 * kappa) * a1 * a1
     H[0, 1] += (1.0 - 3.0 * kappa) * a0 * a1
     H[1, 0] = H[0, 1]
+    return a0, a1
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _fibre_strain(params, family, H, E, lane):
-    """(Ebar = 2 H : E, whether the family is stretched) of lane ``lane`` of E (3, 3, G)."""
-    a0, a1 = params[4], params[5] if family == 0 else -params[5]
+def _fibre_strain(a0, a1, H, E, lane):
+    """(Ebar = 2 H : E, whether the family along (a0, a1, 0) is stretched) of lane ``lane``
+    of E (3, 3, G)."""
     stretched = a0 * a0 * E[0, 0, lane] + a1 * a1 * E[1, 1, lane] + 2.0 * a0 * a1 * E[0, 1, lane] > 0.0
     ebar = 0.0
     for i in range(3):
@@ -111,9 +103,9 @@ def energy(params, E, W):
     for lane in range(LANES):
         W[lane] = mu * (E[0, 0, lane] + E[1, 1, lane] + E[2, 2, lane])
     for family in range(2):
-        _structure(params, family, H)
+        a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(params, family, H, E, lane)
+            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
             if stretched:
                 W[lane] += k1 / (2.0 * k2) * (np.exp(k2 * ebar * ebar) - 1.0)
 
@@ -127,9 +119,9 @@ def energy_stress(params, E, S):
     for i in range(3):
         S[i, i, :] = mu
     for family in range(2):
-        _structure(params, family, H)
+        a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(params, family, H, E, lane)
+            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
             if stretched:
                 psi = k1 * ebar * np.exp(k2 * ebar * ebar)
                 for i in range(3):
@@ -144,9 +136,9 @@ def energy_tangent(params, E, dE, dS):
     H = np.empty((3, 3))
     dS[:] = 0.0
     for family in range(2):
-        _structure(params, family, H)
+        a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(params, family, H, E, lane)
+            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
             if stretched:
                 dEbar = 0.0
                 for i in range(3):

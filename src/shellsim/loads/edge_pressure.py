@@ -9,6 +9,7 @@ from numba import njit
 
 from ..element.frames import cross
 from ..element.tangent import moved_node
+from .pressure import gather_nodes
 
 #: 3-point Gauss rule along an element edge and the 1D quadratic shape functions at its
 #: points, for (corner, mid-side, corner) node triples.
@@ -53,10 +54,8 @@ def edge_pressure_forces(shape, loads, scale, f):
     xe, de, he, fe = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty((3, 3))
     for m in range(loads.edges.shape[0]):
         nodes = loads.edges[m]
+        gather_nodes(shape, nodes, xe, de, he)
         for k in range(3):
-            xe[k] = shape.x[nodes[k]]
-            de[k] = shape.d[nodes[k]]
-            he[k] = shape.h[nodes[k]]
             fe[k] = f[nodes[k]]  # summed in place: the nodal sums keep the order of every step
         edge_forces(xe, de, he, loads.outward[m], scale[m], fe)
         for k in range(3):
@@ -72,10 +71,7 @@ def edge_pressure_tangents(shape, loads, scale, step_u, step_r, k):
     fe = np.empty((3, 3))
     for m in range(loads.edges.shape[0]):
         nodes = loads.edges[m]
-        for a in range(3):
-            xe[a] = shape.x[nodes[a]]
-            de[a] = shape.d[nodes[a]]
-            he[a] = shape.h[nodes[a]]
+        gather_nodes(shape, nodes, xe, de, he)
         k[m] = 0.0
         for move in range(30):
             moved, node = move // 10, nodes[move // 10]

@@ -45,10 +45,10 @@ def face_forces(rule, xe, de, he, face, pressure, fe, ge):
 
 
 @njit(cache=True)
-def _gather_face(shape, nodes, xe, de, he):
-    """The mid-surface points, directors and fibre lengths of an element's nodes (9,) into
-    xe, de (9, 3) and he (9,)."""
-    for a in range(9):
+def gather_nodes(shape, nodes, xe, de, he):
+    """The mid-surface points, directors and fibre lengths of a face's or an edge's nodes
+    (k,) into xe, de (k, 3) and he (k,)."""
+    for a in range(nodes.shape[0]):
         xe[a] = shape.x[nodes[a]]
         de[a] = shape.d[nodes[a]]
         he[a] = shape.h[nodes[a]]
@@ -64,7 +64,7 @@ def pressure_forces(rule, conn, shape, faces, scale, f, g):
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
     for m in range(faces.elements.shape[0]):
         nodes = conn[faces.elements[m]]
-        _gather_face(shape, nodes, xe, de, he)
+        gather_nodes(shape, nodes, xe, de, he)
         for a in range(9):
             fe[a] = f[nodes[a]]  # summed in place: the nodal sums keep the order of every step
             ge[a] = g[nodes[a]]
@@ -83,7 +83,7 @@ def pressure_tangents(rule, conn, shape, faces, scale, step_u, step_r, k):
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
     for m in range(faces.elements.shape[0]):
         nodes = conn[faces.elements[m]]
-        _gather_face(shape, nodes, xe, de, he)
+        gather_nodes(shape, nodes, xe, de, he)
         for a in range(9):
             e1e[a] = shape.e1[nodes[a]]
         k[m] = 0.0

@@ -196,15 +196,11 @@ class Equilibrium:
 
 def _edge_slots(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where each pressure-loaded edge's tangent (E, 9, 15) goes in the elements' (ne, 45,
-    45): an element holding its three nodes, and the rows of their forces and the columns
-    of their DOFs in it, as an index of k."""
+    45): the first element holding its mid-side node (which holds the whole edge), and the
+    rows of the three nodes' forces and the columns of their DOFs in it, as an index of k."""
     edges = model.loads.edge_pressure.edges
-    element = np.empty(len(edges), dtype=np.int64)
-    local = np.empty((len(edges), 3), dtype=np.int64)
-    for m, nodes in enumerate(edges):
-        e = np.flatnonzero(np.isin(model.conn, nodes).sum(axis=1) == 3)[0]
-        element[m] = e
-        local[m] = [int(np.flatnonzero(model.conn[e] == node)[0]) for node in nodes]
+    element = model.body.slots[model.body.node_slots[edges[:, 1]]] // 9
+    local = np.argmax(model.conn[element][:, :, None] == edges[:, None, :], axis=1)  # (E, 3)
     rows = (5 * local[:, :, None] + np.arange(3)).reshape(len(edges), 9)
     cols = (5 * local[:, :, None] + np.arange(5)).reshape(len(edges), 15)
     return element[:, None, None], rows[:, :, None], cols[:, None, :]

@@ -167,7 +167,7 @@ def _named_cells(m) -> dict[str, list[np.ndarray]]:
         return named
     return {name: [np.flatnonzero(np.asarray(block_tags) == tag) if _DIMENSION.get(block.type) == dim else None
                    for block, block_tags in zip(m.cells, tags)]
-            for name, (tag, dim) in ((name, values[:2]) for name, values in m.field_data.items())}
+            for name, (tag, dim) in m.field_data.items()}
 
 
 def _refuse(path: Path, problems: list[str]) -> None:

@@ -98,7 +98,7 @@ class NewtonSolver:
         return norm <= floor or (norm <= settings.force_tolerance * scale
                                  and energy <= settings.energy_tolerance * energy_scale)
 
-    def step(self, t: float) -> tuple[int, float]:
+    def step(self, t: float) -> tuple[int, int, float]:
         """Equilibrium at load time t from the converged state; returns (iterations,
         tangents formed, relative residual). Raises NotConverged with the reason.
 
@@ -158,8 +158,7 @@ class NewtonSolver:
             try:
                 iterations, tangents, residual = self.step(target)
                 step = NewtonStep(t=target, load_time=target, iterations=iterations, tangents=tangents,
-                                  residual=residual,
-                                  cutbacks=cutbacks)
+                                  residual=residual, cutbacks=cutbacks)
                 return step, length
             except NotConverged as why:
                 self.eq.converged.restore(sim)

@@ -359,6 +359,43 @@ def test_mooney_rivlin_patch_follows_the_exact_homogeneous_stretches(interior, s
         np.testing.assert_allclose(h, T * thickness_stretch, rtol=1e-9)
 
 
+#: A fibre law's deck table, one family at 30 degrees from x (Lee-Sacks; HGO's two at
+#: +-30), and its closed form's parameters.
+FIBRE_PATCH_LAWS = {
+    "hgo": ('model = "hgo"\nmu = 20e3\nk1 = 50e3\nk2 = 2.0\nkappa = 0.1\nbeta_deg = 30.0',
+            [20e3, 50e3, 2.0, 0.1]),
+    "lee_sacks": ('model = "lee_sacks"\nc0 = 10e3\nc1 = 2e3\nc2 = 4.0\nc3 = 20.0\ndelta = 0.3\nbeta_deg = 30.0',
+                  [10e3, 2e3, 4.0, 20.0, 0.3]),
+}
+
+
+@pytest.mark.parametrize("interior", [(0.5, 0.5), (0.62, 0.41)])
+@pytest.mark.parametrize("model", FIBRE_PATCH_LAWS)
+def test_fibre_law_patch_follows_the_exact_homogeneous_stretches(model, interior):
+    """The anisotropic laws on a 2 x 2 patch, regular and distorted, material axis 1
+    along x: stretched homogeneously (1.3 x 1.1, 1.4 x 0.8, 1.2 x 1.2), the principal
+    Cauchy stresses at every integration point meet the closed form of
+    tests/test_materials.py to 1e-9, and the fibre lengths follow 1/(l1 l2)."""
+    from .test_materials import _hgo_cauchy, _lee_sacks_cauchy
+
+    law, constants = FIBRE_PATCH_LAWS[model]
+    table = law + '\naxes = { kind = "fixed", direction = [1.0, 0.0, 0.0] }'
+    patch = square_patch(interior=interior, material=(table, ""))
+    cauchy = _hgo_cauchy if model == "hgo" else _lee_sacks_cauchy
+    params = np.array(constants + [np.cos(np.radians(30.0)), np.sin(np.radians(30.0))])
+    for l1, l2 in ((1.3, 1.1), (1.4, 0.8), (1.2, 1.2)):
+        stress, h = hyperelastic_state(patch, patch.x0 * [l1, l2, 1.0], patch.d0, patch.e1f0)
+        s11, s22, s12 = cauchy(params, l1, l2)
+        mean, radius = 0.5 * (s11 + s22), np.hypot(0.5 * (s11 - s22), s12)
+        got_mean = 0.5 * (stress[..., 0] + stress[..., 1])
+        got_radius = np.hypot(0.5 * (stress[..., 0] - stress[..., 1]), stress[..., 2])
+        scale = abs(mean) + radius
+        np.testing.assert_allclose(got_mean + got_radius, mean + radius, rtol=1e-9, atol=1e-9 * scale)
+        np.testing.assert_allclose(got_mean - got_radius, mean - radius, rtol=1e-9, atol=1e-9 * scale)
+        np.testing.assert_allclose(stress[..., 3:], 0.0, atol=1e-9 * scale)
+        np.testing.assert_allclose(h, T / (l1 * l2), rtol=1e-9)
+
+
 def technique_model(technique: int, interior: tuple[float, float]):
     law = 'model = "linear_elastic"\nE = 1000.0\nnu = 0.3'
     return square_patch(interior=interior, material=(law, f"technique = {technique}"))

@@ -1,8 +1,8 @@
 """Hyperelastic laws under zero normal stress: stresses and tangents against finite
 differences of the strain energy, the determinant condition, and the closed-form
-homogeneous responses of incompressible Mooney-Rivlin (benchmarks.md 8B) and
-Holzapfel-Gasser-Ogden. Every law is
-evaluated on a full element group, one random strain per lane."""
+homogeneous responses of incompressible Mooney-Rivlin (benchmarks.md 8B),
+Holzapfel-Gasser-Ogden and Lee-Sacks. Every law is evaluated on a full element group, one
+random strain per lane."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ PARAMETERS = {
     "neo_hookean": np.array([0.3e6, 0.0]),
     "guccione": np.array([25e3, 20.0, 10.0, 10.0]),
     "hgo": np.array([20e3, 50e3, 2.0, 0.1, np.cos(0.6), np.sin(0.6)]),
+    "lee_sacks": np.array([10e3, 2e3, 4.0, 20.0, 0.3, np.cos(0.6), np.sin(0.6)]),
     "linear_elastic": np.array([577.0, 385.0, 5.0 / 6.0]),
 }
 
@@ -141,69 +142,102 @@ def test_mooney_rivlin_homogeneous_stretches_match_the_closed_form(stretch):
     np.testing.assert_allclose(np.sqrt(1 + 2 * E[2, 2]), lam**-2, rtol=1e-12)
 
 
-def _hgo_parameters(beta_deg: float, kappa: float) -> np.ndarray:
-    mu, k1, k2 = PARAMETERS["hgo"][:3]
-    beta = np.radians(beta_deg)
-    return np.array([mu, k1, k2, kappa, np.cos(beta), np.sin(beta)])
-
-
-def _hgo_cauchy(params: np.ndarray, l1: float, l2: float) -> tuple[float, float]:
-    """Cauchy sigma_11, sigma_22 of incompressible HGO under F = diag(l1, l2, 1/(l1 l2))
-    with sigma_33 = 0 (Gasser, Ogden & Holzapfel 2006, Eq 2.8 with the pressure of the free
-    normal): sigma = -p I + 2 W1 B + sum_f 2 W4f (F a_f)(F a_f), W1 = mu/2 + sum_f kappa
-    psi_f, W4f = (1 - 3 kappa) psi_f, psi_f = k1 Ebar exp(k2 Ebar^2) when I4 > 1; the two
-    families' shears cancel."""
+def _hgo_cauchy(params: np.ndarray, l1: float, l2: float) -> tuple[float, float, float]:
+    """Cauchy sigma_11, sigma_22, sigma_12 of incompressible HGO under F = diag(l1, l2,
+    1/(l1 l2)) with sigma_33 = 0 (Gasser, Ogden & Holzapfel 2006, Eq 2.8 with the pressure
+    of the free normal): sigma = -p I + 2 W1 B + sum_f 2 W4f (F a_f)(F a_f), W1 = mu/2 +
+    sum_f kappa psi_f, W4f = (1 - 3 kappa) psi_f, psi_f = k1 Ebar exp(k2 Ebar^2) when
+    I4 > 1; the two families' shears cancel."""
     mu, k1, k2, kappa, c, s = params
     l3 = 1.0 / (l1 * l2)
     I1, I4 = l1**2 + l2**2 + l3**2, (l1 * c) ** 2 + (l2 * s) ** 2
     ebar = kappa * (I1 - 3) + (1 - 3 * kappa) * (I4 - 1)
     psi = k1 * ebar * np.exp(k2 * ebar**2) if I4 > 1 else 0.0
     W1, W4 = mu / 2 + 2 * kappa * psi, 2 * (1 - 3 * kappa) * psi  # summed over the two families
-    return 2 * W1 * (l1**2 - l3**2) + 2 * W4 * (l1 * c) ** 2, 2 * W1 * (l2**2 - l3**2) + 2 * W4 * (l2 * s) ** 2
+    return 2 * W1 * (l1**2 - l3**2) + 2 * W4 * (l1 * c) ** 2, 2 * W1 * (l2**2 - l3**2) + 2 * W4 * (l2 * s) ** 2, 0.0
 
 
-def _hgo_solved(params: np.ndarray, l1: float, l2: float):
+def _lee_sacks_cauchy(params: np.ndarray, l1: float, l2: float) -> tuple[float, float, float]:
+    """Cauchy sigma_11, sigma_22, sigma_12 of incompressible Lee-Sacks under F = diag(l1,
+    l2, 1/(l1 l2)) with sigma_33 = 0: sigma = -p I + 2 W1 B + 2 W4 (F a)(F a), W1 = c0/2 +
+    c1 delta c2 (I1 - 3) exp(c2 (I1 - 3)^2), W4 = c1 (1 - delta) c3 (I4 - 1) exp(c3 (I4 -
+    1)^2) when I4 > 1 (Lee et al. 2014, Eq 1); one family, so a shear holds F diagonal."""
+    c0, c1, c2, c3, delta, c, s = params
+    l3 = 1.0 / (l1 * l2)
+    I1, I4 = l1**2 + l2**2 + l3**2, (l1 * c) ** 2 + (l2 * s) ** 2
+    W1 = c0 / 2 + c1 * delta * c2 * (I1 - 3) * np.exp(c2 * (I1 - 3) ** 2)
+    W4 = c1 * (1 - delta) * c3 * (I4 - 1) * np.exp(c3 * (I4 - 1) ** 2) if I4 > 1 else 0.0
+    return (2 * W1 * (l1**2 - l3**2) + 2 * W4 * (l1 * c) ** 2, 2 * W1 * (l2**2 - l3**2) + 2 * W4 * (l2 * s) ** 2,
+            2 * W4 * l1 * l2 * c * s)
+
+
+#: (model, its parameters with the fibre angle given, the closed-form Cauchy stress)
+#: of each law with a fibre family; the variants are HGO's aligned and dispersed
+#: fibres (kappa = 0.226, the adventitia of Gasser et al. 2006) and Lee-Sacks' stiffening
+#: shared mostly by the fibres or mostly by the matrix.
+FIBRE_LAWS = {
+    "hgo_aligned": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.0, c, s], _hgo_cauchy),
+    "hgo_dispersed": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.226, c, s], _hgo_cauchy),
+    "lee_sacks_fibres": ("lee_sacks", lambda c, s: [10e3, 2e3, 4.0, 20.0, 0.2, c, s], _lee_sacks_cauchy),
+    "lee_sacks_matrix": ("lee_sacks", lambda c, s: [10e3, 2e3, 4.0, 20.0, 0.8, c, s], _lee_sacks_cauchy),
+}
+
+
+def _fibre_law(case: str, beta_deg: float):
+    """(kernels' Material, closed-form Cauchy stress) of a :data:`FIBRE_LAWS` case."""
+    model, params, cauchy = FIBRE_LAWS[case]
+    code, law = law_of(model)
+    beta = np.radians(beta_deg)
+    mat = Material(law=code, params=np.array(params(np.cos(beta), np.sin(beta)), dtype=float), incompressible=True,
+                   C=np.zeros((5, 5)), axes0=np.zeros((1, 1, 1, 3, 3)), technique=1, normal_ratio=0.0,
+                   incremental=False, thickness_update=False)
+    return mat, cauchy
+
+
+def _stretched(mat: Material, l1: float, l2: float):
     """(S~, E) of the law at in-plane stretches l1, l2, in every lane."""
-    code, law = law_of("hgo")
-    mat = Material(law=code, params=params, incompressible=True, C=np.zeros((5, 5)),
-                   axes0=np.zeros((1, 1, 1, 3, 3)), technique=1, normal_ratio=0.0, incremental=False,
-                   thickness_update=False)
     E = np.zeros((3, 3, LANES))
     E[0, 0], E[1, 1] = (l1**2 - 1) / 2, (l2**2 - 1) / 2
     return solved_stress(mat, E)[:2]
 
 
+@pytest.mark.parametrize("case", FIBRE_LAWS)
 @pytest.mark.parametrize("beta_deg", [0.0, 45.0, 90.0])
-@pytest.mark.parametrize("kappa", [0.0, 0.226])
 @pytest.mark.parametrize("stretch", [1.01, 1.2, 1.5])
-def test_hgo_homogeneous_stretches_match_the_closed_form(beta_deg, kappa, stretch):
+def test_fibre_laws_homogeneous_stretches_match_the_closed_form(case, beta_deg, stretch):
     """Equibiaxial stretch and uniaxial stretch along axis 1 (the lateral stress free,
-    its stretch the root of sigma_22 = 0), fibres at 0, 45 and 90 degrees, aligned and
-    dispersed (kappa = 0.226, the adventitia of Gasser et al. 2006): the second Piola
-    stress S = F^-1 sigma F^-T in every lane against the closed form to 1e-9, and the
+    its stretch the root of sigma_22 = 0), fibres at 0, 45 and 90 degrees: the second
+    Piola stress S = F^-1 sigma F^-T in every lane against the closed form to 1e-9, and the
     normal stretch 1/(l1 l2)."""
     from scipy.optimize import brentq
 
-    params = _hgo_parameters(beta_deg, kappa)
-    lateral = brentq(lambda l2: _hgo_cauchy(params, stretch, l2)[1], 0.3, 1.5, xtol=1e-15, rtol=1e-15)
+    mat, cauchy = _fibre_law(case, beta_deg)
+    lateral = brentq(lambda l2: cauchy(mat.params, stretch, l2)[1], 0.3, 1.5, xtol=1e-15, rtol=1e-15)
     for l1, l2 in ((stretch, stretch), (stretch, lateral)):
-        S, E = _hgo_solved(params, l1, l2)
-        s11, s22 = _hgo_cauchy(params, l1, l2)
-        scale = max(abs(s11), abs(s22), params[0])
+        S, E = _stretched(mat, l1, l2)
+        s11, s22, s12 = cauchy(mat.params, l1, l2)
+        scale = max(abs(s11), abs(s22), mat.params[0])
         np.testing.assert_allclose(S[0, 0], s11 / l1**2, rtol=1e-9, atol=1e-12 * scale)
         np.testing.assert_allclose(S[1, 1], s22 / l2**2, rtol=1e-9, atol=1e-9 * scale)
-        np.testing.assert_allclose(S[0, 1], 0.0, atol=1e-12 * scale)
+        np.testing.assert_allclose(S[0, 1], s12 / (l1 * l2), rtol=1e-9, atol=1e-12 * scale)
         np.testing.assert_allclose(np.sqrt(1 + 2 * E[2, 2]), 1 / (l1 * l2), rtol=1e-12)
 
 
-def test_hgo_fibres_in_compression_carry_nothing():
-    """Aligned fibres along axis 1 shortened (uniaxial compression along them): the
-    stress is the neo-Hookean matrix's, mu (1 - l3^2 / l^2) along the fibre."""
-    params = _hgo_parameters(0.0, 0.0)
+@pytest.mark.parametrize("case", ["hgo_aligned", "lee_sacks_fibres"])
+def test_fibres_in_compression_carry_nothing(case):
+    """Fibres along axis 1 shortened (uniaxial compression along them, no lateral stretch):
+    the stress is the matrix's alone, 2 W1 (1 - l3^2 / l^2) along the fibre, with W1 at
+    that state (mu/2 for HGO's aligned fibres)."""
+    mat, _ = _fibre_law(case, 0.0)
     l1 = 0.9
-    S, _ = _hgo_solved(params, l1, 1.0)
-    mu = params[0]
-    np.testing.assert_allclose(S[0, 0], mu * (l1**2 - l1**-2) / l1**2, rtol=1e-12)
+    S, _ = _stretched(mat, l1, 1.0)
+    if case.startswith("hgo"):
+        np.testing.assert_allclose(S[0, 0], mat.params[0] * (l1**2 - l1**-2) / l1**2, rtol=1e-12)
+    else:
+        c0, c1, c2, _, delta = mat.params[:5]
+        i1 = l1**2 + 1 + l1**-2 - 3
+        W1 = c0 / 2 + c1 * delta * c2 * i1 * np.exp(c2 * i1**2)
+        np.testing.assert_allclose(S[0, 0], 2 * W1 * (l1**2 - l1**-2) / l1**2, rtol=1e-12)
 
 
 def test_every_deck_model_of_a_law_is_a_deck_material():

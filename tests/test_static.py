@@ -86,6 +86,8 @@ PATHS = {
     "Holzapfel-Gasser-Ogden": ('model = "hgo"\nmu = 100.0\nk1 = 200.0\nk2 = 2.0\nkappa = 0.1\nbeta_deg = 40.0\n'
                                'density = 1.0\naxes = { kind = "cylindrical", axis = [0.0, 1.0, 0.0] }', HELD, 0.02,
                                0.01),
+    "Lee-Sacks": ('model = "lee_sacks"\nc0 = 100.0\nc1 = 20.0\nc2 = 4.0\nc3 = 20.0\ndelta = 0.3\nbeta_deg = 30.0\n'
+                  'density = 1.0\naxes = { kind = "cylindrical", axis = [0.0, 1.0, 0.0] }', HELD, 0.02, 0.01),
 }
 
 

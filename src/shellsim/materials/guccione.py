@@ -49,6 +49,11 @@ def parameters(material) -> np.ndarray:
     return np.array([material.C1, material.C2, material.C3, material.C4])
 
 
+def fibres(params) -> np.ndarray:
+    """(1, 2) the fibre's direction in material axes 1, 2: axis 1."""
+    return np.array([[1.0, 0.0]])
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _weight(params, i, j):
     """b_ij: C2 along the fibre (11), C4 for the fibre shears (12, 13), C3 for the rest."""

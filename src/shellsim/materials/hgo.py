@@ -67,6 +67,11 @@ def parameters(material) -> np.ndarray:
     return np.array([material.mu, material.k1, material.k2, material.kappa, math.cos(beta), math.sin(beta)])
 
 
+def fibres(params) -> np.ndarray:
+    """(2, 2) the two families' directions in material axes 1, 2: (cos beta, +-sin beta)."""
+    return np.array([[params[4], params[5]], [params[4], -params[5]]])
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def _structure(params, family, H):
     """H (3, 3) = kappa I + (1 - 3 kappa) a a of fibre family 0 (+beta) or 1 (-beta);

@@ -10,7 +10,9 @@ A law is one module of this package with
 - compiled lane functions ``energy(params, E, W)``, ``energy_stress(params, E, S)``
   (S^w = dW/dE) and ``energy_tangent(params, E, dE, dS)`` (dS^w = CC^w : dE), with E, S,
   dE, dS (3, 3, G) Green-Lagrange strains and second Piola stresses in the material frame
-  and W (G,), G the lanes of an element group.
+  and W (G,), G the lanes of an element group;
+- an anisotropic law also gives ``fibres(params)``: (k, 2) the directions of its k fibre
+  families in material axes 1, 2, which the outputs draw.
 Adding a law is writing its module and adding it to :data:`LAWS`.
 """
 
@@ -19,10 +21,10 @@ from __future__ import annotations
 from numba import njit
 
 from ..deck.types import tag_of
-from . import guccione, hgo, mooney_rivlin, st_venant_kirchhoff
+from . import guccione, hgo, lee_sacks, mooney_rivlin, st_venant_kirchhoff
 
 #: The laws, in the order of their codes.
-LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff, hgo)
+LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff, hgo, lee_sacks)
 
 
 def law_of(model: str):

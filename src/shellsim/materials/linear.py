@@ -14,7 +14,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import field_validator
 
-from ..deck.types import Positive, Real, Section
+from ..deck.types import Positive, Real, Section, tag_of
 
 #: Transverse shear correction factor on the 13 and 23 shear moduli (Reissner-Mindlin,
 #: the value Hughes-Liu shells and LS-DYNA's SHRF default use). The thesis does not state
@@ -36,10 +36,11 @@ class LinearElastic(Section):
     @classmethod
     def _compressible(cls, nu: float) -> float:
         if not -1.0 < nu < 0.5:
-            raise ValueError(
-                f"a compressible model needs -1 < nu < 0.5, got {nu}; for incompressible "
-                "tissue use model = 'neo_hookean', 'mooney_rivlin', 'guccione' or 'hgo'"
-            )
+            from .laws import LAWS  # the registry imports this module's neighbours
+
+            incompressible = [tag_of(cls)[1] for law in LAWS if law.INCOMPRESSIBLE for cls in law.MODELS]
+            raise ValueError(f"a compressible model needs -1 < nu < 0.5, got {nu}; for incompressible "
+                             f"tissue use model = {' | '.join(repr(m) for m in incompressible)}")
         return nu
 
 

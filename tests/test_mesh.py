@@ -358,3 +358,49 @@ def test_mesh_png_is_not_blank(tmp_path):
     pixels = np.asarray(Image.open(tmp_path / "mesh.png").convert("L"), dtype=float)
     assert pixels.shape == (300, 400)
     assert pixels.std() > 20  # a blank (uniform) image has zero spread
+
+
+def _cylinder_stl(path: Path, radius: float, length: float, around: int = 128, along: int = 48) -> Path:
+    """An open cylinder about z, z in [0, length], as 2 x around x along facets."""
+    import meshio
+
+    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
+    z = np.linspace(0.0, length, along + 1)
+    points = np.array([[radius * np.cos(p), radius * np.sin(p), h] for h in z for p in phi])
+    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
+    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
+    triangles = np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
+    meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
+    return path
+
+
+def test_a_triangulated_cylinder_is_remeshed_into_quad9_on_its_surface(tmp_path):
+    """An STL of an open cylinder (R = 1, L = 3, 128 facets around) remeshed with elements
+    of 0.3: 9-node quads only, every node within 0.1% of the radius (the facets' chords
+    sit 0.03% inside it), the area within 0.1% of 2 pi R L, directors pointing outward,
+    and the two open ends as edge sets: the one the deck names by a point, and open_1."""
+    stl = _cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0)
+    _, mesh = build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.3\n'
+                    'boundaries = { inlet = [1.0, 0.0, 0.0] }')
+    assert mesh.conn.shape[1] == 9 and mesh.n_elements > 100
+    radius = np.hypot(mesh.x[:, 0], mesh.x[:, 1])
+    np.testing.assert_allclose(radius, 1.0, rtol=1e-3)
+    np.testing.assert_allclose(mid_surface_area(mesh), 2 * np.pi * 3.0, rtol=1e-3)
+    outward = np.einsum("ni,ni->n", mesh.director[:, :2], mesh.x[:, :2] / radius[:, None])
+    assert outward.min() > 0.99
+    assert {"inlet", "open_1"} <= set(mesh.sets) and "open_2" not in mesh.sets
+    np.testing.assert_allclose(mesh.x[mesh.sets["inlet"].nodes, 2], 0.0, atol=1e-9)
+    np.testing.assert_allclose(mesh.x[mesh.sets["open_1"].nodes, 2], 3.0, atol=1e-9)
+    assert len(mesh.sets["inlet"].edges) * 2 == len(mesh.sets["inlet"].nodes)  # a closed loop of 3-node edges
+
+
+def test_a_surface_needs_an_element_size_and_two_names_cannot_share_a_loop(tmp_path):
+    from shellsim.deck import parse_deck
+    from shellsim.errors import DeckError
+
+    stl = _cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0, around=32, along=8)
+    with pytest.raises(DeckError, match="element_size"):
+        parse_deck(deck_text(f'builder = "file"\npath = "{stl.as_posix()}"', ""))
+    with pytest.raises(MeshError, match="find the same boundary loop"):
+        build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.5\n'
+              'boundaries = { a = [1.0, 0.0, 0.0], b = [0.0, 1.0, 0.1] }')

@@ -43,6 +43,8 @@ class Mesh:
     director : (n_nodes, 3) float — unit nodal directors.
     thickness : (n_nodes,) float — nodal fibre lengths h_a.
     sets : name -> NamedSet.
+    cell_vectors : name -> (n_elements, 3) float — per-element vectors a mesh file carries
+        (e.g. fibre directions).
     """
 
     x: np.ndarray
@@ -50,6 +52,7 @@ class Mesh:
     director: np.ndarray
     thickness: np.ndarray
     sets: dict[str, NamedSet] = field(default_factory=dict)
+    cell_vectors: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_nodes(self) -> int:
@@ -222,17 +225,19 @@ def edges_within(conn: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return inside[np.sort(first)]
 
 
-def snap_points(x: np.ndarray, points: dict[str, tuple[float, float, float]]) -> dict[str, NamedSet]:
-    """Named point sets at the nodes that coincide with the given positions.
+def snap_points(x: np.ndarray, points: dict[str, tuple[float, float, float]],
+                reach: float | None = None) -> dict[str, NamedSet]:
+    """Named point sets at the nodes nearest the given positions.
 
-    A position farther than 1e-6 of the model size from every node is an error (it would
-    silently probe the wrong place)."""
+    A position farther than ``reach`` (by default 1e-6 of the model size: the node must
+    be there) from every node is an error (it would silently probe the wrong place)."""
     size = float(np.linalg.norm(x.max(axis=0) - x.min(axis=0))) or 1.0
+    reach = 1e-6 * size if reach is None else reach
     sets = {}
     for name, p in points.items():
         distance = np.linalg.norm(x - np.asarray(p), axis=1)
         nearest = int(np.argmin(distance))
-        if distance[nearest] > 1e-6 * size:
+        if distance[nearest] > reach:
             raise MeshError(
                 f"mesh.points.{name}: {list(p)} is not at a node; the nearest node is "
                 f"{x[nearest].round(12).tolist()}, {distance[nearest]:.4g} away"

@@ -13,7 +13,7 @@ from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Field, model_validator
 
-from .types import Positive, Section, tag_of
+from .types import Name, Positive, Section, Vec3, tag_of
 
 SetKinds = dict[str, str]
 
@@ -169,14 +169,40 @@ class Hemisphere(Section):
         return _edges("equator", "sym_x", "sym_y") | _points("pole", "equator_x", "equator_y")
 
 
+#: File endings read as triangulated surfaces, remeshed into quads.
+SURFACE_SUFFIXES = (".stl", ".obj", ".ply", ".vtp", ".off")
+
+
 class MeshFile(Section):
     """A mesh of 9-node quadrilaterals read with meshio (any format it reads), ``path``
     relative to the deck. Named sets come from the file's cell sets (gmsh physical groups)
-    or from point-data arrays named ``set_<name>``."""
+    or from point-data arrays named ``set_<name>``.
+
+    A triangulated surface (.stl, .obj, .ply, .vtp, .off) is remeshed with gmsh into quads
+    of about ``element_size``; its open boundary loops become edge sets, each of
+    ``boundaries`` naming the loop nearest its point (e.g. ``inlet = [0.0, 0.0, 0.0]``), the
+    others ``open_1``, ``open_2``, ... along the surface's longest extent."""
 
     builder: Literal["file"]
     path: Annotated[str, Field(strict=True, min_length=1)]
+    element_size: Positive | None = None
+    boundaries: dict[Name, Vec3] = {}
     DIVISIONS: ClassVar[dict[str, int]] = {}
+
+    @property
+    def surface(self) -> bool:
+        """Whether the file is a triangulated surface to remesh."""
+        return self.path.lower().endswith(SURFACE_SUFFIXES)
+
+    @model_validator(mode="after")
+    def _remeshing(self) -> "MeshFile":
+        if self.surface and self.element_size is None:
+            raise ValueError(f"'{self.path}' is a triangulated surface, remeshed into quads: give element_size "
+                             "(the quads' size, in the deck's length unit)")
+        if not self.surface and (self.element_size is not None or self.boundaries):
+            raise ValueError(f"element_size and boundaries are for a triangulated surface ({', '.join(SURFACE_SUFFIXES)}); "
+                             f"'{self.path}' is read as a quad9 mesh")
+        return self
 
 
 Geometry = Annotated[
@@ -204,6 +230,8 @@ LENGTH_RATIO = 1e6
 
 def lengths(geometry: Section) -> dict[str, float]:
     """A builder's lengths by key: its numbers other than angles (none for a mesh file)."""
+    if isinstance(geometry, MeshFile):
+        return {}
     return {k: v for k, v in geometry.model_dump().items() if isinstance(v, float) and not k.endswith("_deg")}
 
 

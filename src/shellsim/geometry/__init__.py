@@ -22,14 +22,30 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     """The mesh of ``deck``; ``base_dir`` resolves a ``builder = 'file'`` path.
 
     Directors are the exact surface normals of the built geometry (averaged where patches
-    meet); for a file, its own directors or else the averaged element normals.
+    meet); for a file, its own directors or else the averaged element normals; for a
+    remeshed surface the averaged element normals, pointing away from its centre.
     Raises MeshError when the mesh cannot be built, a file lacks a set the deck names, or the
     mesh fails the geometric checks.
     """
     g = deck.geometry
     director = thickness = None
     surface_normals: list = []
-    if g.builder == "file":
+    cell_vectors: dict[str, np.ndarray] = {}
+    if g.builder == "file" and g.surface:
+        from .session import gmsh_session
+        from .surfaces import boundary_loops, remesh
+
+        path = resolve_mesh_path(deck, base_dir)
+        with gmsh_session(name="surface") as gmsh:
+            x, conn = remesh(gmsh, path, g.element_size)
+        sets = boundary_loops(x, conn, g.boundaries, path)
+        problems = check_references(deck, {name: s.kind for name, s in sets.items()})
+        if problems:
+            raise MeshError(f"the deck names sets that remeshed surface '{path}' does not have "
+                            f"(it has {', '.join(sets) or 'no open boundary'}):\n"
+                            + "\n".join(f"  - {p}" for p in problems))
+        preferred = x[conn[:, 8]] - x.mean(axis=0)  # outward, for a vessel
+    elif g.builder == "file":
         from .importing import read_mesh
 
         path = resolve_mesh_path(deck, base_dir)
@@ -39,7 +55,7 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
         if problems:
             raise MeshError(f"the deck names sets that mesh file '{path}' does not have:\n"
                             + "\n".join(f"  - {p}" for p in problems))
-        director, thickness = imported.director, imported.thickness
+        director, thickness, cell_vectors = imported.director, imported.thickness, imported.cell_vectors
         preferred = director[conn[:, 8]] if director is not None else None
     else:
         from . import builders
@@ -62,9 +78,11 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
         thickness = np.full(len(x), deck.section.thickness)
     all_elements = np.arange(len(conn))
     sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
-    sets = sets | snap_points(x, deck.mesh.points)
-    mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets)
-    source = f"mesh file '{path}'" if g.builder == "file" else f"builder '{g.builder}'"
+    # on a remeshed surface nobody knows where the nodes are: the nearest within half an element
+    reach = 0.5 * g.element_size if g.builder == "file" and g.surface else None
+    sets = sets | snap_points(x, deck.mesh.points, reach)
+    mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors)
+    source = f"{'surface' if g.surface else 'mesh'} file '{path}'" if g.builder == "file" else f"builder '{g.builder}'"
     check_mesh(mesh, source, deck.section.points_through_thickness)
     return mesh
 

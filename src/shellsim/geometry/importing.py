@@ -7,7 +7,8 @@ Named sets come from
   vertices a point set;
 - point-data arrays ``set_<name>`` (nonzero = member; 1 point, 2 edge, 3 surface set), as
   :func:`shellsim.output.mesh_files.write_mesh_vtu` writes them.
-Point data ``director`` (n, 3) and ``thickness`` (n,) are used when present.
+Point data ``director`` (n, 3) and ``thickness`` (n,) are used when present, and cell data
+of three components on the quad9 cells (e.g. fibre directions) is kept by name.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, id_list
 from ..mesh import NamedSet, edges_within
 from .file_checks import (
     GMSH_QUAD9, collapsed_problem, missing_nodes_problem, point_data_problems, repeated_node_problem,
@@ -39,17 +40,18 @@ _NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", 
 
 @dataclass(frozen=True)
 class ImportedMesh:
-    """What a file gives: x (n, 3), conn (ne, 9), sets, and optional director (n, 3) and
-    thickness (n,)."""
+    """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and
+    thickness (n,), and per-element vectors (ne, 3) by name."""
 
     x: np.ndarray
     conn: np.ndarray
     sets: dict[str, NamedSet]
     director: np.ndarray | None
     thickness: np.ndarray | None
+    cell_vectors: dict[str, np.ndarray]
 
 
-def _read(path: Path):
+def read_meshio(path: Path):
     """meshio's mesh of ``path``. meshio prints its complaints and calls ``sys.exit`` on a file
     it cannot parse (which would end a study's worker): both are caught and become the message."""
     import meshio
@@ -79,7 +81,7 @@ def read_mesh(path: Path) -> ImportedMesh:
     Raises MeshError, naming every defect with ids and places, for a file that is not a
     quad9 shell mesh or whose nodes, directors, thicknesses or elements cannot be used.
     """
-    m = _read(Path(path))
+    m = read_meshio(Path(path))
     blocks = [i for i, block in enumerate(m.cells) if block.type == "quad9"]
     others = sorted({b.type for b in m.cells if b.type in _NOT_QUAD9})
     if not blocks or others:
@@ -123,7 +125,24 @@ def read_mesh(path: Path) -> ImportedMesh:
             if code in _KIND_OF_CODE:
                 sets[key[len(SET_PREFIX):]] = _node_set(_KIND_OF_CODE[code], np.flatnonzero(values), conn)
 
-    return ImportedMesh(x, conn, sets, director, thickness)
+    return ImportedMesh(x, conn, sets, director, thickness, _cell_vectors(path, m, blocks))
+
+
+def _cell_vectors(path: Path, m, blocks: list[int]) -> dict[str, np.ndarray]:
+    """The cell-data arrays of three components on every quad9 block, (ne, 3) by name;
+    non-finite or zero vectors are refused, naming the elements."""
+    vectors = {}
+    for name, per_block in m.cell_data.items():
+        arrays = [np.asarray(per_block[i]) for i in blocks]
+        if not all(a.ndim == 2 and a.shape[1] == 3 and a.dtype.kind == "f" for a in arrays):
+            continue
+        values = np.concatenate(arrays).astype(float)
+        bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1) | (np.linalg.norm(values, axis=1) == 0.0))
+        if len(bad):
+            raise MeshError(f"mesh file '{path}': cell vectors '{name}' are not a direction (not finite, or zero) "
+                            f"in {len(bad)} element(s): {id_list(bad + 1)}")
+        vectors[name] = values
+    return vectors
 
 
 def _cell_sets(path: Path, m, blocks: list[int], offsets: np.ndarray, index: np.ndarray,

@@ -1,0 +1,140 @@
+"""Triangulated surfaces (STL, OBJ, PLY, VTP, OFF: anything meshio reads as triangles),
+e.g. a vessel from segmentation, remeshed with gmsh into 9-node quadrilaterals.
+
+The triangles become one discrete gmsh surface, which ``classifySurfaces`` splits at
+sharp ridges into patches gmsh can reparametrise (``createGeometry``); the quasi-structured
+quad algorithm then meshes them. The second-order nodes are made straight and then moved
+onto the plane of the nearest triangle: gmsh's own placement through the
+reparametrisation can land a node across a patch's seam, folding its element.
+The surface's open boundary loops (a vessel's ends) become edge sets, named by the deck
+(``boundaries``: the loop nearest each point) or ``open_1``, ``open_2``, ... along the
+surface's longest extent.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshError, place
+from ..mesh import EDGES, NamedSet
+
+#: Dihedral angle above which gmsh splits the surface into patches (degrees): a ridge
+#: sharper than this stays a ridge.
+RIDGE_DEG = 40.0
+#: The quasi-structured quad algorithm ends at about half the size it is given.
+QUAD_SIZE_FACTOR = 2.0
+#: Name prefix of the open boundary loops the deck does not name.
+LOOP_PREFIX = "open_"
+
+
+def read_triangles(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Points (n, 3) and triangles (m, 3) of a surface file, unused points dropped."""
+    from .importing import read_meshio
+
+    surface = read_meshio(path)
+    blocks = [np.asarray(b.data, dtype=np.int64) for b in surface.cells if b.type == "triangle"]
+    others = sorted({b.type for b in surface.cells if b.type not in ("triangle", "vertex", "line")})
+    if not blocks or others:
+        found = ", ".join(sorted({b.type for b in surface.cells})) or "no cells"
+        raise MeshError(f"surface file '{path}' should hold triangles only; found {found}")
+    triangles = np.concatenate(blocks)
+    points = np.asarray(surface.points, dtype=float)
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    bad = np.flatnonzero(~np.all(np.isfinite(points), axis=1))
+    if np.isin(bad, triangles).any():
+        raise MeshError(f"surface file '{path}' has points that are not finite numbers, e.g. point {bad[0]}")
+    used, triangles = np.unique(triangles, return_inverse=True)
+    return points[used], triangles.reshape(-1, 3)
+
+
+def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
+    """Quad9 nodes (n, 3) and connectivity (ne, 9) of the surface in ``path`` remeshed
+    with elements of about ``size``, inside a gmsh session."""
+    from .gmsh_extract import extract
+
+    points, triangles = read_triangles(path)
+    surface = gmsh.model.addDiscreteEntity(2)
+    gmsh.model.mesh.addNodes(2, surface, np.arange(1, len(points) + 1), points.ravel())
+    gmsh.model.mesh.addElementsByType(surface, 2, [], (triangles + 1).ravel())
+    gmsh.model.mesh.classifySurfaces(np.radians(RIDGE_DEG), True, True, np.pi)
+    gmsh.model.mesh.createGeometry()
+    for key, value in (("Mesh.MeshSizeMin", QUAD_SIZE_FACTOR * size), ("Mesh.MeshSizeMax", QUAD_SIZE_FACTOR * size),
+                       ("Mesh.Algorithm", 11), ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.SecondOrderLinear", 1)):
+        gmsh.option.setNumber(key, value)
+    try:
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(2)
+    except Exception as error:  # gmsh raises a bare Exception with its last error
+        raise MeshError(f"surface file '{path}' could not be remeshed with geometry.element_size = {size:g}: "
+                        f"{error}; a self-intersecting or non-manifold surface cannot be, and a size far "
+                        "from the triangles' may need changing") from None
+    x, conn, _, _ = extract(gmsh, f"surface file '{path}'")
+    inner = np.unique(conn[:, 4:])
+    x[inner] = onto_surface(points, triangles, x[inner])
+    return x, conn
+
+
+def onto_surface(points: np.ndarray, triangles: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """``nodes`` (k, 3) moved along its normal onto the plane of the triangle (of
+    ``points`` (n, 3), ``triangles`` (m, 3)) whose centre is nearest."""
+    from scipy.spatial import cKDTree
+
+    corners = points[triangles]
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    area = np.linalg.norm(normals, axis=1)
+    corners, normals = corners[area > 0], normals[area > 0] / area[area > 0, None]  # slivers have no plane
+    _, nearest = cKDTree(corners.mean(axis=1)).query(nodes)
+    height = np.einsum("ki,ki->k", nodes - corners[nearest, 0], normals[nearest])
+    return nodes - height[:, None] * normals[nearest]
+
+
+def boundary_loops(x: np.ndarray, conn: np.ndarray, names: dict[str, tuple[float, float, float]],
+                   path: Path) -> dict[str, NamedSet]:
+    """The mesh's open boundary loops as edge sets: each of ``names`` takes the loop
+    nearest its point, the rest are ``open_1``, ``open_2``, ... ordered along the
+    surface's longest extent."""
+    loops = _loops(conn)
+    centres = np.array([x[np.unique(edges)].mean(axis=0) for edges in loops]).reshape(-1, 3)
+    named: dict[str, np.ndarray] = {}
+    taken: dict[int, str] = {}
+    for name, point in names.items():
+        if not loops:
+            raise MeshError(f"geometry.boundaries.{name}: surface file '{path}' is closed; it has no open boundary")
+        nearest = [min(np.linalg.norm(x[np.unique(edges)] - point, axis=1)) for edges in loops]
+        loop = int(np.argmin(nearest))
+        if loop in taken:
+            raise MeshError(f"geometry.boundaries.{name} = {place(point)} and geometry.boundaries.{taken[loop]} "
+                            f"find the same boundary loop, near {place(centres[loop])}")
+        taken[loop] = name
+        named[name] = loops[loop]
+    axis = int(np.argmax(np.ptp(x, axis=0)))
+    rest = sorted((i for i in range(len(loops)) if i not in taken), key=lambda i: centres[i, axis])
+    named |= {f"{LOOP_PREFIX}{k}": loops[i] for k, i in enumerate(rest, start=1)}
+    return {name: NamedSet("edge", np.unique(edges), edges=edges) for name, edges in named.items()}
+
+
+def _loops(conn: np.ndarray) -> list[np.ndarray]:
+    """Element edges used by one element only, as (corner, mid-side, corner) triples (k, 3),
+    grouped into connected loops."""
+    edges = conn[:, EDGES].reshape(-1, 3)
+    key = np.sort(edges[:, [0, 2]], axis=1)
+    _, first, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    free = edges[first[counts == 1]]
+    parent = {int(n): int(n) for n in free[:, [0, 2]].ravel()}
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for a, _, b in free:
+        parent[root(int(a))] = root(int(b))
+    groups: dict[int, list[int]] = {}
+    for row, (a, _, _) in enumerate(free):
+        groups.setdefault(root(int(a)), []).append(row)
+    return [free[rows] for rows in groups.values()]

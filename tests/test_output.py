@@ -21,6 +21,7 @@ from typer.testing import CliRunner
 
 from shellsim.cli import app, sigterm_as_interrupt
 from shellsim.deck import load_deck, parse_deck
+from shellsim.element.shape import gauss_rule
 from shellsim.errors import OutputError
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
 from shellsim.output.series import check_space
@@ -393,3 +394,76 @@ def test_a_radial_probe_on_its_axis_is_refused_with_a_message():
                               'component = "radial"\n')
     with pytest.raises(MeshError, match=r"probe 'r': set 'x0y0' has a point on the probe's axis"):
         prepared(deck)
+
+
+# --- The whole model and its fibres: Test 9 (static) mirrored, helical fibres ----------
+
+
+@pytest.fixture(scope="module")
+def mirrored_run(tmp_path_factory):
+    """Test 9 solved statically, its axes turned by -30 degrees at the inner face to +30 at
+    the outer, written whole (mirrored across its three symmetry planes) with the fibres,
+    and rendered with them and the initial outline."""
+    text = (ROOT / "decks" / "verification" / "test09_aorta_static.toml").read_text()
+    text = text.replace('axes = { kind = "cylindrical", axis = [0.0, 0.0, 1.0] }',
+                        'axes = { kind = "cylindrical", axis = [0.0, 0.0, 1.0], angle_deg = [-30.0, 30.0] }')
+    assert "angle_deg" in text
+    text = text.replace("[output]\n", '[output]\nmirror = true\nformats = ["xdmf", "vtu"]\nsolid = true\n'
+                        'fields = ["displacement", "cauchy_stress", "pressure_band", "fibres"]\n', 1)
+    text += '\n[[output.render]]\nfield = "cauchy_stress"\nfibres = true\noutline = true\nsize = [640, 480]\n'
+
+    deck = tmp_path_factory.mktemp("mirrored") / "deck.toml"
+    deck.write_text(text)
+    folder = deck.parent / "out"
+    result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
+    assert result.exit_code == 0, result.output
+    return folder, load_deck(deck)
+
+
+def test_a_mirrored_series_is_the_whole_tube_and_its_fibres_turn_through_the_wall(mirrored_run):
+    """The quarter tube with its end cap is written as eight copies: its points fill all
+    eight octants, the deformed shape stays symmetric (a point and its mirror image move
+    as mirror images), and the fibres are unit vectors at +-30 degrees from the hoop
+    direction on the outermost and innermost layers at t = 0."""
+    from shellsim.output.series import StoredSeries
+
+    folder, deck = mirrored_run
+    series = StoredSeries(folder)
+    points = series.points
+    assert len(points) % 8 == 0
+    part = len(points) // 8
+    assert {tuple(np.sign(p)) for p in points[::97] if np.all(np.abs(p) > 1e-6)} == {
+        (sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)}
+    point_data, cell_data = series.frame(len(series.times) - 1)
+    u = point_data["displacement"]
+    np.testing.assert_allclose(u[part:2 * part], u[:part] * [-1, 1, 1], atol=1e-12 * np.abs(u).max())  # across x = 0
+    _, first = series.frame(0)
+    fibre = first["fibre_1"]
+    np.testing.assert_allclose(np.linalg.norm(fibre, axis=1), 1.0, rtol=1e-12)
+    cells = len(series.cells) // 8
+    depths = gauss_rule(deck.section.points_through_thickness)[0]
+    part_fibres = fibre[:cells].reshape(-1, len(depths), 9, 3)  # (element, layer, point): the solid view
+    centres = points[series.cells[:cells]].mean(axis=1).reshape(-1, len(depths), 9, 3)
+    on_wall = centres[..., 2] < 0.039  # the cylinder, not the cap
+    hoop = np.stack([-centres[..., 1], centres[..., 0], np.zeros_like(centres[..., 0])], axis=-1)
+    hoop /= np.linalg.norm(hoop, axis=-1, keepdims=True)
+    turned = np.degrees(np.arctan2(part_fibres[..., 2], np.einsum("elqi,elqi->elq", part_fibres, hoop)))
+    for k, depth in enumerate(depths):  # -30 degrees at the inner face, +30 at the outer, linear between
+        np.testing.assert_allclose(turned[:, k][on_wall[:, k]], 30.0 * depth, atol=0.1)
+
+
+def test_the_deck_render_draws_the_fibres_and_the_outline(mirrored_run):
+    folder, _ = mirrored_run
+    (png,) = (folder / "renders").glob("cauchy_stress_xx_iso_fibres_outline_*.png")
+    size, contrast = _picture_contrast(png)
+    assert size == (640, 480) and contrast > 20.0
+
+
+def test_mirror_needs_a_symmetry_plane_and_fibres_a_fibre_law():
+    from shellsim.errors import DeckError
+
+    plate = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0')
+    with pytest.raises(DeckError, match="no symmetry boundary to mirror across"):
+        parse_deck(plate + "\n[output]\nmirror = true\n")
+    with pytest.raises(DeckError, match="'fibres' draws a fibre-reinforced law's fibres"):
+        parse_deck(plate + '\n[output]\nfields = ["displacement", "fibres"]\n')

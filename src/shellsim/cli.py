@@ -205,10 +205,11 @@ def run(
 
 def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
     """The renders a deck's [[output.render]] asks for, from the series just written."""
-    from .output.render import render_field
+    from .output.render import Overlays, render_field
 
     for picture in scene.output.render:
-        written = render_field(folder, picture.field, picture.frame, picture.view, picture.size)
+        written = render_field(folder, picture.field, picture.frame, picture.view, picture.size,
+                               overlays=Overlays(picture.fibres, picture.outline))
         if not quiet:
             _announce(written)
 
@@ -274,14 +275,22 @@ def render(
     view: Annotated[str, typer.Option(help="iso, top, front or side.")] = "iso",
     size: Annotated[str, typer.Option(help="Picture size in pixels, WIDTHxHEIGHT.")] = "1200x900",
     out_dir: Annotated[Path | None, typer.Option("--out", help="Folder for the pictures [default: RESULTS/renders].")] = None,
+    show: Annotated[list[str] | None, typer.Option(help="Draw also (repeat for both): 'fibres', the fibre "
+                                                        "directions (written with output.fields 'fibres'); "
+                                                        "'outline', the initial shape's element outlines.")] = None,
 ) -> None:
     """Render a field of a run on its deformed shape: off-screen PNGs with a labelled scalar
     bar, element outlines, and each sub-cell coloured by its integration point's value."""
-    from .output.render import VIEWS, render_field
+    from .output.render import VIEWS, Overlays, render_field
 
     if view not in ("iso", *VIEWS):
         raise typer.BadParameter(f"unknown view '{view}'; expected iso, {', '.join(VIEWS)}", param_hint="--view")
-    _announce(render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir))
+    unknown = set(show or []) - set(Overlays._fields)
+    if unknown:
+        raise typer.BadParameter(f"cannot show {', '.join(sorted(unknown))}; expected {', '.join(Overlays._fields)}",
+                                 param_hint="--show")
+    _announce(render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir,
+                           Overlays(**{name: True for name in show or []})))
 
 
 @app.command()

@@ -19,7 +19,7 @@ from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
 from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
-from .errors import NotYetAvailable
+from .errors import MeshError, NotYetAvailable
 from .loads.edge_pressure import EDGE_DN, EDGE_N, EDGE_W
 from .loads.pressure import pressure_forces
 from .materials.laws import law_of
@@ -136,12 +136,14 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
     a3 the lamina normal g_r x g_s / |.|, a1 the preferred direction projected on the
-    lamina (circumferential about ``axes.axis`` for cylindrical axes, ``axes.direction``
-    for fixed ones, g_r for an isotropic law or where the preferred direction is normal
-    to the lamina, e.g. on a tube's axis), a2 = a3 x a1."""
+    lamina (circumferential about ``axes.axis`` for cylindrical axes or about the nearest
+    segment of a centreline, ``axes.direction`` for fixed ones, the element's vector ``axes.field`` from the mesh file, g_r for an
+    isotropic law or where the preferred direction is normal to the lamina, e.g. on a
+    tube's axis), then turned about a3 by the layer's ``axes.angle_deg``; a2 = a3 x a1."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
+    turns = np.zeros(len(tz)) if axes is None else axes.angles(tz)
     for k, t in enumerate(tz):
-        position, jac = _layer_geometry(mesh, N, dNr, dNs, t)
+        position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)
         g_r, g_s = jac[..., 0], jac[..., 1]
         normal = np.cross(g_r, g_s)
         normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
@@ -149,6 +151,10 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
             preferred = g_r
         elif axes.kind == "cylindrical":
             preferred = np.cross(np.asarray(axes.axis, dtype=float), position - np.asarray(axes.origin))
+        elif axes.kind == "centreline":
+            preferred = axes.preferred(position)
+        elif axes.kind == "mesh":
+            preferred = np.broadcast_to(_mesh_vectors(mesh, axes.field)[:, None], g_r.shape)
         else:
             preferred = np.broadcast_to(np.asarray(axes.direction, dtype=float), g_r.shape)
         a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
@@ -156,8 +162,18 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
         fallback = g_r - np.sum(g_r * normal, axis=-1, keepdims=True) * normal
         a1 = np.where(size > 1e-9 * np.linalg.norm(preferred, axis=-1, keepdims=True) + 1e-300, a1, fallback)
         a1 /= np.linalg.norm(a1, axis=-1, keepdims=True)
+        a1 = np.cos(turns[k]) * a1 + np.sin(turns[k]) * np.cross(normal, a1)
         out[:, :, k] = np.stack([a1, np.cross(normal, a1), normal], axis=-2)
     return out
+
+
+def _mesh_vectors(mesh: Mesh, name: str) -> np.ndarray:
+    """The mesh's per-element vectors ``name`` (ne, 3), or a message saying what there is."""
+    if name not in mesh.cell_vectors:
+        there = ", ".join(f"'{n}'" for n in mesh.cell_vectors) or "none (only a mesh file's cell data can give them)"
+        raise MeshError(f"material.axes.field = '{name}': the mesh has no per-element vectors of that name; "
+                        f"it has {there}")
+    return mesh.cell_vectors[name]
 
 
 def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
@@ -175,10 +191,12 @@ def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(rs)), rs])
 
 
-def _layer_geometry(mesh: Mesh, N, dNr, dNs, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """Initial positions (ne, q, 3) and Jacobians dy/d(r, s, t) (ne, q, 3, 3, columns) of
-    the points (N, dNr, dNs: (q, 9)) on the layer at thickness coordinate t."""
-    xe, fe = mesh.x[mesh.conn], (0.5 * mesh.thickness[:, None] * mesh.director)[mesh.conn]
+def layer_geometry(x: np.ndarray, d: np.ndarray, h: np.ndarray, conn: np.ndarray, N, dNr, dNs,
+                   t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (ne, q, 3) and Jacobians dy/d(r, s, t) (ne, q, 3, 3, columns) of the
+    points (N, dNr, dNs: (q, 9)) on the layer at thickness coordinate t, for mid-surface
+    nodes x (n, 3), directors d (n, 3) and fibre lengths h (n,)."""
+    xe, fe = x[conn], (0.5 * h[:, None] * d)[conn]
     pos = xe + t * fe
     jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
                     np.einsum("qa,eai->eqi", N, fe)], axis=-1)
@@ -189,7 +207,7 @@ def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) inverses of dy/d(r, s, t) on the initial configuration."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     for k, t in enumerate(tz):
-        out[:, :, k] = np.linalg.inv(_layer_geometry(mesh, N, dNr, dNs, t)[1])
+        out[:, :, k] = np.linalg.inv(layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)[1])
     return out
 
 

@@ -1,16 +1,37 @@
-"""Material axes of an anisotropic law: how the fibre direction is laid on the lamina, and
-the base of the laws' deck tables."""
+"""Material axes of an anisotropic law: how the fibre direction is laid on the lamina (a
+rule, or vectors from the mesh file, turned by an angle that may vary through the
+thickness), and the base of the laws' deck tables."""
 
 from __future__ import annotations
 
 from typing import Annotated, ClassVar, Literal, Union
 
+import numpy as np
 from pydantic import Field, field_validator, model_validator
 
-from .types import Section, Vec3
+from .types import Name, Section, Vec3
+
+#: An angle of material axis 1 about the lamina normal (degrees).
+Angle = Annotated[float, Field(strict=True, ge=-180.0, le=180.0, allow_inf_nan=False)]
 
 
-class CylindricalAxes(Section):
+class TurnedAxes(Section):
+    """Axis 1 turned about the lamina normal, toward axis 2, by ``angle_deg``: one angle,
+    or a list of angles at evenly spaced depths from the bottom face to the top face
+    (linear between them), e.g. a vessel wall's helical fibres [-60, 60]."""
+
+    angle_deg: Union[Angle, Annotated[list[Angle], Field(min_length=2)]] = 0.0
+
+    def angles(self, depths: np.ndarray) -> np.ndarray:
+        """The angle (radians) at each thickness coordinate of ``depths`` (nt,), -1 the
+        bottom face and +1 the top."""
+        values = np.atleast_1d(np.asarray(self.angle_deg, dtype=float))
+        if len(values) == 1:
+            return np.radians(np.full(len(depths), values[0]))
+        return np.radians(np.interp(depths, np.linspace(-1.0, 1.0, len(values)), values))
+
+
+class CylindricalAxes(TurnedAxes):
     """Material axes of a tube: 1 circumferential, 2 axial (along ``axis`` through
     ``origin``), 3 radial (the lamina normal)."""
 
@@ -24,7 +45,7 @@ class CylindricalAxes(Section):
         return _nonzero_vector(v)
 
 
-class FixedAxes(Section):
+class FixedAxes(TurnedAxes):
     """Material axis 1 along ``direction`` projected on the lamina; 3 is the lamina normal."""
 
     kind: Literal["fixed"]
@@ -36,7 +57,44 @@ class FixedAxes(Section):
         return _nonzero_vector(v)
 
 
-Axes = Annotated[Union[CylindricalAxes, FixedAxes], Field(discriminator="kind")]
+class CentrelineAxes(TurnedAxes):
+    """Material axes of a curved vessel: about the polyline ``points`` (its centreline,
+    at least two points), 1 circumferential, 2 along the nearest centreline segment, 3 the
+    lamina normal."""
+
+    kind: Literal["centreline"]
+    points: Annotated[list[Vec3], Field(min_length=2)]
+
+    @field_validator("points")
+    @classmethod
+    def _segments(cls, points: list) -> list:
+        if any(a == b for a, b in zip(points, points[1:])):
+            raise ValueError("consecutive centreline points must differ")
+        return points
+
+    def preferred(self, position: np.ndarray) -> np.ndarray:
+        """t x (p - c) at positions p (..., 3): c the nearest point of the centreline,
+        t its segment's unit direction."""
+        ends = np.asarray(self.points, dtype=float)
+        start, step = ends[:-1], np.diff(ends, axis=0)  # (S, 3)
+        p = position[..., None, :]
+        along = np.clip(np.sum((p - start) * step, axis=-1) / np.sum(step * step, axis=-1), 0.0, 1.0)
+        nearest = start + along[..., None] * step  # (..., S, 3)
+        segment = np.argmin(np.linalg.norm(p - nearest, axis=-1), axis=-1)[..., None, None]
+        c = np.take_along_axis(nearest, segment, axis=-2)[..., 0, :]
+        t = step[segment[..., 0, 0]]
+        return np.cross(t / np.linalg.norm(t, axis=-1, keepdims=True), position - c)
+
+
+class MeshAxes(TurnedAxes):
+    """Material axis 1 along the mesh file's per-element vectors ``field`` (cell data of 3
+    components), projected on the lamina; 3 is the lamina normal."""
+
+    kind: Literal["mesh"]
+    field: Name
+
+
+Axes = Annotated[Union[CylindricalAxes, CentrelineAxes, FixedAxes, MeshAxes], Field(discriminator="kind")]
 
 
 def _nonzero_vector(v: tuple[float, float, float]) -> tuple[float, float, float]:

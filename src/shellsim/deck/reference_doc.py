@@ -12,7 +12,7 @@ from pydantic_core import PydanticUndefined
 from . import schema
 from .curves import Curve
 from .geometry import BUILDERS
-from .axes import CylindricalAxes, FixedAxes
+from .axes import CentrelineAxes, CylindricalAxes, FixedAxes, MeshAxes
 from .material import MATERIALS
 from .types import tag_of
 
@@ -61,7 +61,7 @@ def deck_reference() -> str:
     for cls in MATERIALS.values():
         lines += _table(cls, f'### model = "{_tag(cls)}"', skip_tag=True)
     lines += ["Material axes (`axes`), chosen by `kind`:", ""]
-    for cls in (CylindricalAxes, FixedAxes):
+    for cls in (CylindricalAxes, CentrelineAxes, FixedAxes, MeshAxes):
         lines += _table(cls, f'#### kind = "{_tag(cls)}"', skip_tag=True)
     lines += _table(schema.ShellSection, "## [section]")
     lines += ["## [[boundary]]", "", "Chosen by `type`.", ""]

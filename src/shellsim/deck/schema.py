@@ -31,7 +31,8 @@ class Meta(Section):
 class MeshOptions(Section):
     """``[mesh]``: element divisions per builder direction (see the builder), optional
     irregular element boundaries of a rectangle (fractions of its length along y = 0 and
-    y = width, 0 first and 1 last), and extra named points snapped to the nearest node."""
+    y = width, 0 first and 1 last), and extra named points at nodes (on a remeshed surface,
+    the node nearest within half an element)."""
 
     divisions: dict[str, Count] = {}
     boundaries_y0: list[Real] | None = None
@@ -303,7 +304,7 @@ class Solver(Section):
 
 OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
-    "pressure_band", "green_lagrange_strain", "von_mises",
+    "pressure_band", "green_lagrange_strain", "von_mises", "fibres",
 ]
 VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
 TENSOR_QUANTITIES = ("stress", "strain")
@@ -375,12 +376,23 @@ class Probe(Section):
 class Render(Section):
     """PNGs written at the end of a completed run (as ``shellsim render``): ``field``
     (one of the written ``output.fields``) on the deformed shape, for the ``last`` frame,
-    a frame number, or ``all`` (also an animated GIF), seen from ``view``, ``size`` pixels."""
+    a frame number, or ``all`` (also an animated GIF), seen from ``view``, ``size`` pixels;
+    ``fibres`` draws the fibre directions over it (with ``fibres`` among the fields),
+    ``outline`` the initial shape's element outlines."""
 
     field: OutputField = "pressure_band"
     frame: Literal["last", "all"] | Count = "last"
     view: Literal["iso", "top", "front", "side"] = "iso"
     size: tuple[Count, Count] = (1200, 900)
+    fibres: bool = False
+    outline: bool = False
+
+    @field_validator("field")
+    @classmethod
+    def _coloured(cls, field: str) -> str:
+        if field == "fibres":
+            raise ValueError("fibres are drawn over a coloured field: give another field and fibres = true")
+        return field
 
 
 class Output(Section):
@@ -389,13 +401,16 @@ class Output(Section):
     them (stresses and strains per integration-point sub-cell, with a smoothed nodal
     version); the ``formats`` (``xdmf``: results.xdmf + results.h5; ``vtu``: results.pvd +
     frames/); ``solid`` writes the shell as a solid between its faces instead of its
-    mid-surface; probes (history.csv) and renders."""
+    mid-surface; ``mirror`` writes the model whole, reflected across the planes of its
+    ``symmetry`` boundaries (a quarter tube as eight copies with a z symmetry plane);
+    probes (history.csv) and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
     fields: list[OutputField] = ["displacement", "director", "thickness", "cauchy_stress", "pressure_band"]
     formats: list[Literal["xdmf", "vtu"]] = ["xdmf"]
     solid: bool = False
+    mirror: bool = False
     probe: list[Probe] = []
     render: list[Render] = []
 
@@ -405,7 +420,8 @@ class Output(Section):
             raise ValueError("give either 'interval' or 'times', not both")
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
             raise ValueError(f"'times' must be strictly increasing, got {self.times}")
-        unwritten = sorted({r.field for r in self.render} - set(self.fields))
+        unwritten = sorted({r.field for r in self.render} - set(self.fields)
+                           | ({"fibres"} - set(self.fields) if any(r.fibres for r in self.render) else set()))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
         duplicates = repeated([p.name for p in self.probe])
@@ -519,6 +535,11 @@ class Deck(Section):
             )
         if self.material.HYPERELASTIC and self.section.technique is None:
             problems.append("section.technique: a hyperelastic material needs a large-strain technique (1, 2 or 3)")
+        if self.output.mirror and not any(b.type == "symmetry" for b in self.boundary):
+            problems.append("output.mirror: the deck has no symmetry boundary to mirror across")
+        if "fibres" in self.output.fields and not self.material.ANISOTROPIC:
+            problems.append(f"output.fields: 'fibres' draws a fibre-reinforced law's fibres, and material.model = "
+                            f"'{self.material.model}' has none")
         problems += proportion_problems(self.geometry, self.section.thickness)
         if self.solver.method == "static" and self.solver.static.control == "arc_length":
             moved = [f"boundary[{i}]" for i, b in enumerate(self.boundary) if b.type == "prescribed" and b.value != 0]

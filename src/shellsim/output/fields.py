@@ -8,7 +8,9 @@ Sub-cell corners are not shared between elements. The shell view sits on the
 mid-surface with thickness-mean values (von Mises: the largest over the layers), and point fields ``<name>_nodal`` beside the cell
 fields carry a smoothed version (Gauss values extrapolated to the element's nodes, averaged
 over the elements sharing a node). The solid view places the corners on the layer
-boundaries (top, bottom and between) from directors and fibre lengths.
+boundaries (top, bottom and between) from directors and fibre lengths. Fibre directions
+(``fibres``) are unit cell vectors per family, ``fibre_1``, ``fibre_2``: every layer's in
+the solid view, the middle layer's in the shell view.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from ..solver.simulation import Simulation
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
+#: The output field of fibre directions, written as one cell vector per family:
+#: fibre_1, fibre_2, ...
+FIBRES, FIBRE_PREFIX = "fibres", "fibre_"
 NODAL_SUFFIX = "_nodal"
 #: Fields the shell view shows as their largest value through the thickness (a bent
 #: shell's equivalent stress peaks at its faces); the others as the thickness mean.
@@ -132,6 +137,27 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
+def fibre_directions(sim: Simulation) -> list[np.ndarray]:
+    """Each fibre family's current unit direction at every integration point, (ne, nq,
+    nt, 3) per family: its initial direction (the law's ``fibres`` in the initial material
+    frame) carried by the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1."""
+    from ..materials.laws import LAWS
+    from ..model import layer_geometry
+
+    model, state, rule = sim.model, sim.state, sim.model.rule
+    nq = len(rule.wq)
+    F = np.empty((model.n_elements, nq, len(rule.tz), 3, 3))
+    for k, t in enumerate(rule.tz):
+        jac = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], t)[1]
+        F[:, :, k] = jac @ model.body.jac0_inv[:, :nq, k]
+    frames = model.material.axes0  # rows: material axes 1, 2, 3
+    directions = []
+    for c, s in LAWS[model.material.law].fibres(model.material.params):
+        current = np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
+        directions.append(current / np.linalg.norm(current, axis=-1, keepdims=True))
+    return directions
+
+
 def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.ndarray:
     """Nodal version (ne * 16, ...) at the shell view's corners of per-point values
     (ne, 9, ...): the biquadratic through an element's 3 x 3 Gauss values, read at its
@@ -170,4 +196,10 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
+    if FIBRES in fields:
+        for family, directions in enumerate(fibre_directions(sim), start=1):
+            if mesh.solid:
+                cell_data[f"{FIBRE_PREFIX}{family}"] = directions.transpose(0, 2, 1, 3).reshape(-1, 3)
+            else:  # the shell view shows the middle layer's fibres
+                cell_data[f"{FIBRE_PREFIX}{family}"] = directions[:, :, len(model.rule.tz) // 2].reshape(-1, 3)
     return point_data, cell_data

@@ -151,13 +151,34 @@ def _frame_indices(frame: str | int, count: int) -> list[int]:
     return [index % count]
 
 
+class Overlays(NamedTuple):
+    """What a field render draws besides the field: each fibre family as short lines
+    through the sub-cells' centres (from the ``fibre_<k>`` cell vectors), and the initial
+    shape's element outlines in grey."""
+
+    fibres: bool = False
+    outline: bool = False
+
+
+class Drawn(NamedTuple):
+    """The overlays' data for one frame: the initial points (P, 3) whose element outlines
+    are drawn, or None, and each fibre family's cell vectors (C, 3)."""
+
+    initial: np.ndarray | None = None
+    fibres: list[np.ndarray] = []
+
+
+NO_OVERLAYS = Overlays()
+
+
 def render_field(folder: Path, field: str = "pressure_band", frame: str | int = "last", view: str = "iso",
                  size: tuple[int, int] = (1200, 900), component: str | None = None,
-                 out_dir: Path | None = None) -> list[Path]:
+                 out_dir: Path | None = None, overlays: Overlays = NO_OVERLAYS) -> list[Path]:
     """PNGs of ``field`` on the deformed shape for the chosen frames of the series in
     ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
-    to ``out_dir`` (default ``folder/renders``). Returns the files written."""
-    from .fields import NODAL_SUFFIX, labelled
+    to ``out_dir`` (default ``folder/renders``), with the ``overlays``. Returns the files
+    written."""
+    from .fields import FIBRE_PREFIX, NODAL_SUFFIX, labelled
     from .series import StoredSeries
 
     series = StoredSeries(folder)
@@ -174,11 +195,17 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     out_dir = output_folder(out_dir or folder / RENDERS_DIR)
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []
-    for index, (point_data, _), (values, on_cells, _) in zip(indices, frames, picked):
+    if overlays.fibres and not any(name.startswith(FIBRE_PREFIX) for name in frames[0][1]):
+        raise OutputError(f"the series in '{folder}' holds no fibre directions; write them with "
+                          "output.fields = [..., 'fibres'] (a fibre-reinforced material)")
+    stem += "".join(f"_{name}" for name, shown in overlays._asdict().items() if shown)
+    for index, (point_data, cell_data), (values, on_cells, _) in zip(indices, frames, picked):
         path = out_dir / f"{stem}_{index:04d}.png"
         deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
+        fibres = [v for name, v in sorted(cell_data.items()) if name.startswith(FIBRE_PREFIX)] if overlays.fibres else []
         _render_frame(deformed, series, Colouring(values, on_cells, bar, (low, high)), view, size,
-                      f"{title}\nt = {series.times[index]:.6g}", path)
+                      f"{title}\nt = {series.times[index]:.6g}", path,
+                      Drawn(series.points if overlays.outline else None, fibres))
         written.append(path)
     if frame == "all":
         import imageio.v3 as iio
@@ -199,9 +226,15 @@ class Colouring(NamedTuple):
     limits: tuple[float, float]
 
 
+#: Colours of the fibre families' lines.
+FIBRE_COLOURS = ["black", "white", "magenta"]
+
+
 def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, size: tuple[int, int], caption: str,
-                  path: Path) -> None:
-    """One PNG: the sub-cells at ``points`` coloured by ``colouring``, element outlines on top."""
+                  path: Path, drawn: Drawn) -> None:
+    """One PNG: the sub-cells at ``points`` coloured by ``colouring``, element outlines on
+    top; the ``drawn`` overlays: the initial shape's outlines in grey, and each fibre
+    family as lines through the cell centres."""
     values, on_cells, bar, limits = colouring
     pv = _pyvista()
     cell_type = pv.CellType.HEXAHEDRON if series.cell_type == "hexahedron" else pv.CellType.QUAD
@@ -212,7 +245,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
         grid.point_data["values"] = values
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
-    plotter.add_mesh(grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
+    field_actor = plotter.add_mesh(grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
                      scalar_bar_args={"title": bar, "color": "black", "vertical": False, "fmt": "%.4g",
                                       "position_x": 0.2, "position_y": 0.04, "width": 0.6, "height": 0.07,
                                       "title_font_size": max(10, size[1] // 40),
@@ -220,6 +253,19 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
     rings = np.arange(0, len(points), 16)[:, None] + ELEMENT_RING[None]
     lines = np.hstack([np.full((len(rings), 1), len(ELEMENT_RING)), rings]).ravel()
     plotter.add_mesh(pv.PolyData(points, lines=lines), color="black", line_width=2)
+    if drawn.initial is not None:
+        plotter.add_mesh(pv.PolyData(drawn.initial, lines=lines), color="#808080", line_width=1)
+    field_actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # lines on the surface drawn in front
+    if drawn.fibres:
+        faces = series.cells[:, 4:] if series.cell_type == "hexahedron" else series.cells  # a layer's top face
+        centres = points[faces].mean(axis=1)
+        length = 0.35 * np.median(np.linalg.norm(points[series.cells[:, 2]] - points[series.cells[:, 0]], axis=1))
+        for family, directions in enumerate(drawn.fibres):
+            ends = np.concatenate([centres - length * directions, centres + length * directions])
+            segments = np.column_stack([np.full(len(centres), 2), np.arange(len(centres)),
+                                        np.arange(len(centres)) + len(centres)]).ravel()
+            plotter.add_mesh(pv.PolyData(ends, lines=segments), color=FIBRE_COLOURS[family % len(FIBRE_COLOURS)],
+                             line_width=2)
     plotter.add_text(caption, position="upper_left", font_size=max(8, size[1] // 70), color="black")
     _look(plotter, view, points)
     try:

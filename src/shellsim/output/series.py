@@ -21,6 +21,7 @@ from ..errors import OutputError
 from ..solver.run import Listener, Run
 from .fields import OutputMesh, frame_fields, output_mesh
 from .folder import write_atomically
+from .mirror import mirrored_mesh, mirrored_values, mirrors, symmetry_planes
 
 XDMF_NAME, PVD_NAME, FRAMES_DIR = "results.xdmf", "results.pvd", "frames"
 
@@ -85,7 +86,9 @@ class FrameWriter(Listener):
 
     def __init__(self, folder: Path, run: Run, output: Output):
         self.fields = list(output.fields)
-        self.mesh = output_mesh(run.model, output.solid)
+        self.part = output_mesh(run.model, output.solid)
+        self.copies = mirrors(symmetry_planes(run.deck, run.mesh) if output.mirror else [])
+        self.mesh = mirrored_mesh(self.part, self.copies)
         self.run = run
         self.series = []
         try:
@@ -95,13 +98,21 @@ class FrameWriter(Listener):
             self.close()
             raise OutputError(f"cannot write the {kind} series in '{folder}': {error.strerror or error}") from None
 
+    def _fields(self, run: Run) -> tuple[dict, dict]:
+        """(point_data, cell_data) of the current state on the written (mirrored) mesh."""
+        point_data, cell_data = frame_fields(run.sim, self.part, self.fields)
+        if self.copies.count == 1:
+            return point_data, cell_data
+        return ({name: mirrored_values(v, self.copies) for name, v in point_data.items()},
+                {name: mirrored_values(v, self.copies) for name, v in cell_data.items()})
+
     def frame_bytes(self) -> int:
         """Bytes one frame of the current state takes in every format (data only)."""
-        point_data, cell_data = frame_fields(self.run.sim, self.mesh, self.fields)
+        point_data, cell_data = self._fields(self.run)
         return len(self.series) * sum(a.nbytes for a in (*point_data.values(), *cell_data.values()))
 
     def on_frame(self, run: Run) -> None:
-        point_data, cell_data = frame_fields(run.sim, self.mesh, self.fields)
+        point_data, cell_data = self._fields(run)
         t = run.sim.state.t
         for series in self.series:
             try:

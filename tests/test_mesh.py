@@ -62,6 +62,10 @@ BUILDERS = {
     "hemisphere": (
         'builder = "hemisphere"\nradius = 10.0', "divisions = { patch = 2 }", math.pi / 2 * 100.0,
         lambda p: np.linalg.norm(p, axis=1) - 10.0),
+    # the zone between colatitude 18 degrees and the equator: a quarter of 2 pi R^2 cos 18
+    "hemisphere with a polar hole": (
+        'builder = "hemisphere"\nradius = 10.0\nhole_deg = 18.0', "divisions = { patch = 4 }",
+        math.pi / 2 * 100.0 * math.cos(math.radians(18.0)), lambda p: np.linalg.norm(p, axis=1) - 10.0),
 }
 
 
@@ -120,6 +124,7 @@ EXACT_NORMALS = {
     "cylindrical_panel": lambda p: p * [1, 0, 1] / np.hypot(p[:, 0], p[:, 2])[:, None],
     "tube": lambda p: p * [1, 1, 0] / np.hypot(p[:, 0], p[:, 1])[:, None],
     "hemisphere": lambda p: p / np.linalg.norm(p, axis=1)[:, None],
+    "hemisphere with a polar hole": lambda p: p / np.linalg.norm(p, axis=1)[:, None],
     "rectangle": lambda p: np.tile([0.0, 0.0, 1.0], (len(p), 1)),
 }
 
@@ -321,7 +326,7 @@ def test_one_name_on_cells_of_two_kinds_is_refused(tmp_path, monkeypatch):
     m = meshio.read(path)
     m.cells.append(meshio.CellBlock("line3", np.array([[0, 1, 4]])))
     m.cell_sets = {"left": [np.array([0])] * (len(m.cells) - 1) + [np.array([0])]}
-    monkeypatch.setattr(importing, "_read", lambda _: m)
+    monkeypatch.setattr(importing, "read_meshio", lambda _: m)
     with pytest.raises(MeshError, match=r"plate.msh': the name 'left' is given to edge and surface cells"):
         build('builder = "file"\npath = "' + str(path) + '"')
 

@@ -155,18 +155,25 @@ class Tube(Section):
 
 class Hemisphere(Section):
     """Quarter of a hemisphere (x, y, z >= 0) centred at the origin, pole on +z, built from
-    three curved patches of ``patch`` x ``patch`` elements.
+    three curved patches of ``patch`` x ``patch`` elements; with a polar hole of
+    ``hole_deg`` (its half-angle from the pole, e.g. 18 for the pinched hemisphere
+    benchmark), from two patches between the hole and the equator.
 
-    Sets: edges ``equator``, ``sym_x`` (x = 0), ``sym_y`` (y = 0); points ``pole``,
-    ``equator_x``, ``equator_y``.
+    Sets: edges ``equator``, ``sym_x`` (x = 0), ``sym_y`` (y = 0); points ``equator_x``,
+    ``equator_y`` (where the pinched hemisphere is loaded); and point ``pole``, or with a
+    hole edge ``hole`` and points ``hole_x``, ``hole_y``.
     """
 
     builder: Literal["hemisphere"]
     radius: Positive
+    hole_deg: Annotated[float, Field(strict=True, ge=0, lt=90)] = 0.0
     DIVISIONS: ClassVar[dict[str, int]] = {"patch": 2}
 
     def sets(self) -> SetKinds:
-        return _edges("equator", "sym_x", "sym_y") | _points("pole", "equator_x", "equator_y")
+        sets = _edges("equator", "sym_x", "sym_y") | _points("equator_x", "equator_y")
+        if self.hole_deg > 0:
+            return sets | _edges("hole") | _points("hole_x", "hole_y")
+        return sets | _points("pole")
 
 
 #: File endings read as triangulated surfaces, remeshed into quads.

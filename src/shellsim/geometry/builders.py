@@ -243,10 +243,35 @@ def _sphere_octant(sk: Sketch, centre: tuple[float, float, float], radius: float
 
 
 def hemisphere(sk: Sketch, g: Hemisphere, mesh: MeshOptions, thickness: float) -> Hint:
-    octant = _sphere_octant(sk, (0.0, 0.0, 0.0), g.radius, mesh.divisions["patch"])
+    n = mesh.divisions["patch"]
+    if g.hole_deg > 0:
+        return _holed_hemisphere(sk, g.radius, math.radians(g.hole_deg), n)
+    octant = _sphere_octant(sk, (0.0, 0.0, 0.0), g.radius, n)
     for name in ("equator", "sym_x", "sym_y"):
         sk.name(1, name, octant[name])
     for name, p in zip(("equator_x", "equator_y", "pole"), octant["points"]):
+        sk.name(0, name, [p])
+    return lambda x: x
+
+
+def _holed_hemisphere(sk: Sketch, radius: float, hole: float, n: int) -> Hint:
+    """The quarter hemisphere with a polar hole of half-angle ``hole`` (rad): two patches
+    split at 45 degrees, each n x n, bounded by the equator, two meridians and the hole's
+    circle of latitude."""
+    s2 = 1 / math.sqrt(2)
+    o, ring_centre = sk.point((0.0, 0.0, 0.0)), sk.point((0.0, 0.0, radius * math.cos(hole)))
+    ring = radius * math.sin(hole)
+    ex, em, ey = sk.point((radius, 0, 0)), sk.point((radius * s2, radius * s2, 0)), sk.point((0, radius, 0))
+    hx, hm, hy = (sk.point((ring * cx, ring * cy, radius * math.cos(hole))) for cx, cy in ((1, 0), (s2, s2), (0, 1)))
+    sk.patch([sk.arc(ex, o, em, n), sk.arc(em, o, hm, n), sk.arc(hm, ring_centre, hx, n), sk.arc(hx, o, ex, n)],
+             sphere_centre=o)
+    sk.patch([sk.arc(em, o, ey, n), sk.arc(ey, o, hy, n), sk.arc(hy, ring_centre, hm, n), sk.arc(hm, o, em, n)],
+             sphere_centre=o)
+    sk.name(1, "equator", [sk.arc(ex, o, em, n), sk.arc(em, o, ey, n)])
+    sk.name(1, "sym_y", [sk.arc(ex, o, hx, n)])
+    sk.name(1, "sym_x", [sk.arc(ey, o, hy, n)])
+    sk.name(1, "hole", [sk.arc(hx, ring_centre, hm, n), sk.arc(hm, ring_centre, hy, n)])
+    for name, p in (("equator_x", ex), ("equator_y", ey), ("hole_x", hx), ("hole_y", hy)):
         sk.name(0, name, [p])
     return lambda x: x
 

@@ -409,3 +409,34 @@ def test_a_surface_needs_an_element_size_and_two_names_cannot_share_a_loop(tmp_p
     with pytest.raises(MeshError, match="find the same boundary loop"):
         build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.5\n'
               'boundaries = { a = [1.0, 0.0, 0.0], b = [0.0, 1.0, 0.1] }')
+
+
+def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
+    """Per-element vectors in a quad9 file's cell data (written back by write_mesh_vtu)
+    give material axis 1, projected on the lamina and turned by angle_deg: a plate whose
+    elements carry (1, 1, 5) (mostly normal to it) gets axis 1 along (1, 1, 0) / sqrt 2,
+    turned 30 degrees toward axis 2 on every layer."""
+    import meshio
+
+    from shellsim.deck import parse_deck
+    from shellsim.model import build_model
+    from shellsim.output.mesh_files import write_mesh_vtu
+
+    _, plate = build('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "divisions = { length = 2, width = 2 }")
+    write_mesh_vtu(plate, tmp_path / "plate.vtu")
+    written = meshio.read(tmp_path / "plate.vtu")
+    written.cell_data["fibre"] = [np.tile([1.0, 1.0, 5.0], (plate.n_elements, 1))]
+    written.write(tmp_path / "plate.vtu")
+    text = deck_text(f'builder = "file"\npath = "{(tmp_path / "plate.vtu").as_posix()}"')
+    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+                        'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\n'
+                        'axes = { kind = "mesh", field = "fibre", angle_deg = 30.0 }')
+    deck = parse_deck(text)
+    mesh = build_mesh(deck)
+    np.testing.assert_allclose(mesh.cell_vectors["fibre"], np.tile([1.0, 1.0, 5.0], (plate.n_elements, 1)))
+    axes = build_model(deck, mesh).material.axes0
+    expected = np.radians(45.0 + 30.0)
+    np.testing.assert_allclose(axes[..., 0, :], np.broadcast_to([np.cos(expected), np.sin(expected), 0.0], axes[..., 0, :].shape),
+                               atol=1e-12)
+    with pytest.raises(MeshError, match="material.axes.field = 'fibres'.*it has 'fibre'"):
+        build_model(parse_deck(text.replace('field = "fibre"', 'field = "fibres"')), mesh)

@@ -2,10 +2,13 @@
 e.g. a vessel from segmentation, remeshed with gmsh into 9-node quadrilaterals.
 
 The triangles become one discrete gmsh surface, which ``classifySurfaces`` splits at
-sharp ridges into patches gmsh can reparametrise (``createGeometry``); the quasi-structured
-quad algorithm then meshes them. The second-order nodes are made straight and then moved
-onto the plane of the nearest triangle: gmsh's own placement through the
-reparametrisation can land a node across a patch's seam, folding its element.
+sharp ridges into patches gmsh can reparametrise (``createGeometry``). Those are meshed
+with triangles, recombined and split into quads (the frontal-Delaunay and blossom full-quad
+algorithms, which give the same mesh on every run; the quasi-structured algorithm does
+not). Every node is then moved onto the plane of the nearest facet, the second-order
+ones from straight edges: gmsh places the split's new corners on the chords, and its own
+second-order placement through the reparametrisation can land a node across a patch's
+seam, folding its element.
 The surface's open boundary loops (a vessel's ends) become edge sets, named by the deck
 (``boundaries``: the loop nearest each point) or ``open_1``, ``open_2``, ... along the
 surface's longest extent.
@@ -24,8 +27,6 @@ from ..mesh import EDGES, NamedSet
 #: Dihedral angle above which gmsh splits the surface into patches (degrees): a ridge
 #: sharper than this stays a ridge.
 RIDGE_DEG = 40.0
-#: The quasi-structured quad algorithm ends at about half the size it is given.
-QUAD_SIZE_FACTOR = 2.0
 #: Name prefix of the open boundary loops the deck does not name.
 LOOP_PREFIX = "open_"
 
@@ -62,8 +63,9 @@ def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     gmsh.model.mesh.addElementsByType(surface, 2, [], (triangles + 1).ravel())
     gmsh.model.mesh.classifySurfaces(np.radians(RIDGE_DEG), True, True, np.pi)
     gmsh.model.mesh.createGeometry()
-    for key, value in (("Mesh.MeshSizeMin", QUAD_SIZE_FACTOR * size), ("Mesh.MeshSizeMax", QUAD_SIZE_FACTOR * size),
-                       ("Mesh.Algorithm", 11), ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.SecondOrderLinear", 1)):
+    for key, value in (("Mesh.MeshSizeMin", size), ("Mesh.MeshSizeMax", size),
+                       ("Mesh.Algorithm", 8), ("Mesh.RecombinationAlgorithm", 3),
+                       ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.SecondOrderLinear", 1)):
         gmsh.option.setNumber(key, value)
     try:
         gmsh.model.mesh.generate(2)
@@ -73,13 +75,11 @@ def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
                         f"{error}; a self-intersecting or non-manifold surface cannot be, and a size far "
                         "from the triangles' may need changing") from None
     x, conn, _, _ = extract(gmsh, f"surface file '{path}'")
-    inner = np.unique(conn[:, 4:])
-    x[inner] = onto_surface(points, triangles, x[inner])
-    return x, conn
+    return onto_surface(points, triangles, x), conn
 
 
 def onto_surface(points: np.ndarray, triangles: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """``nodes`` (k, 3) moved along its normal onto the plane of the triangle (of
+    """``nodes`` (k, 3) moved along the normal onto the plane of the triangle (of
     ``points`` (n, 3), ``triangles`` (m, 3)) whose centre is nearest."""
     from scipy.spatial import cKDTree
 

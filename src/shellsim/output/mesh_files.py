@@ -16,11 +16,11 @@ from ..mesh import Mesh
 def write_mesh_vtu(mesh: Mesh, path: Path) -> None:
     """Write ``mesh`` to ``path`` (.vtu). Each named set becomes a point-data array
     ``set_<name>`` (1 point, 2 edge, 3 surface set; 0 outside) and, for surface sets, a
-    cell-data array of the same name."""
+    cell-data array of the same name; per-element vectors are cell data by their names."""
     import meshio
 
     point_data = {"director": mesh.director, "thickness": mesh.thickness}
-    cell_data = {}
+    cell_data = {name: [vectors] for name, vectors in mesh.cell_vectors.items()}
     for name, named in mesh.sets.items():
         member = np.zeros(mesh.n_nodes, dtype=np.uint8)
         member[named.nodes] = KIND_CODE[named.kind]

@@ -152,8 +152,8 @@ def _frame_indices(frame: str | int, count: int) -> list[int]:
 
 
 class Overlays(NamedTuple):
-    """What a field render draws besides the field: each fibre family as short lines
-    through the sub-cells' centres (from the ``fibre_<k>`` cell vectors), and the initial
+    """What a field render draws besides the field: each fibre family as a short line
+    through each element's centre (from the ``fibre_<k>`` cell vectors), and the initial
     shape's element outlines in grey."""
 
     fibres: bool = False
@@ -234,7 +234,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
                   path: Path, drawn: Drawn) -> None:
     """One PNG: the sub-cells at ``points`` coloured by ``colouring``, element outlines on
     top; the ``drawn`` overlays: the initial shape's outlines in grey, and each fibre
-    family as lines through the cell centres."""
+    family as lines through the elements' centres."""
     values, on_cells, bar, limits = colouring
     pv = _pyvista()
     cell_type = pv.CellType.HEXAHEDRON if series.cell_type == "hexahedron" else pv.CellType.QUAD
@@ -256,11 +256,13 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
     if drawn.initial is not None:
         plotter.add_mesh(pv.PolyData(drawn.initial, lines=lines), color="#808080", line_width=1)
     field_actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # lines on the surface drawn in front
-    if drawn.fibres:
-        faces = series.cells[:, 4:] if series.cell_type == "hexahedron" else series.cells  # a layer's top face
+    if drawn.fibres:  # one line per element (and layer): through its centre sub-cell, q = 4
+        middle = np.arange(len(series.cells)) % 9 == 4
+        faces = series.cells[middle, 4:] if series.cell_type == "hexahedron" else series.cells[middle]  # top faces
         centres = points[faces].mean(axis=1)
-        length = 0.35 * np.median(np.linalg.norm(points[series.cells[:, 2]] - points[series.cells[:, 0]], axis=1))
-        for family, directions in enumerate(drawn.fibres):
+        length = 1.2 * np.median(np.linalg.norm(points[faces[:, 2]] - points[faces[:, 0]], axis=1))
+        for family, every in enumerate(drawn.fibres):
+            directions = every[middle]
             ends = np.concatenate([centres - length * directions, centres + length * directions])
             segments = np.column_stack([np.full(len(centres), 2), np.arange(len(centres)),
                                         np.arange(len(centres)) + len(centres)]).ravel()

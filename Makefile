@@ -3,7 +3,7 @@
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
-DECK   ?= decks/artery_inflation.toml
+DECK   ?= decks/tissue/carotid_hgo_pulse.toml
 OUT    ?= results
 STAMP  := $(VENV)/.installed
 

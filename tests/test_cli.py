@@ -11,7 +11,7 @@ from shellsim.cli import app
 from .conftest import ROOT, deck_text
 
 runner = CliRunner()
-DEFAULT_DECK = ROOT / "decks" / "artery_inflation.toml"
+ARTERY_DECK = ROOT / "decks" / "artery_inflation.toml"
 
 
 def test_help_lists_every_command():
@@ -22,7 +22,7 @@ def test_help_lists_every_command():
 
 
 def test_check_summarises_a_valid_deck():
-    result = runner.invoke(app, ["check", str(DEFAULT_DECK)])
+    result = runner.invoke(app, ["check", str(ARTERY_DECK)])
     assert result.exit_code == 0, result.output
     for fragment in ("tube", "guccione", "19 elements", "technique 1", "anisotropic"):
         assert fragment in result.output
@@ -82,7 +82,7 @@ def test_a_mesh_larger_than_the_memory_is_refused_after_meshing(tmp_path, monkey
     from shellsim.solver import outlook
 
     monkeypatch.setattr(outlook, "available_bytes", lambda: 1e8)
-    result = runner.invoke(app, ["check", str(DEFAULT_DECK)])
+    result = runner.invoke(app, ["check", str(ARTERY_DECK)])
     assert result.exit_code == 2
     assert "the mesh has 19 elements: a run needs about 400 MB of memory and 100 MB is available" in \
         " ".join(result.output.split())
@@ -103,7 +103,7 @@ def test_check_gives_the_step_and_suggests_m1_for_a_thin_shell_on_m2(tmp_path):
 def test_mesh_writes_the_vtu_and_the_png(tmp_path):
     import meshio
 
-    result = runner.invoke(app, ["mesh", str(DEFAULT_DECK), "--out", str(tmp_path / "out")])
+    result = runner.invoke(app, ["mesh", str(ARTERY_DECK), "--out", str(tmp_path / "out")])
     assert result.exit_code == 0, result.output
     written = meshio.read(tmp_path / "out" / "mesh.vtu")
     assert written.cells[0].type == "quad9" and len(written.cells[0].data) == 19
@@ -114,7 +114,7 @@ def test_mesh_writes_the_vtu_and_the_png(tmp_path):
 def test_mesh_into_an_unwritable_place_is_a_clear_error(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("")
-    result = runner.invoke(app, ["mesh", str(DEFAULT_DECK), "--out", str(blocker / "sub")])
+    result = runner.invoke(app, ["mesh", str(ARTERY_DECK), "--out", str(blocker / "sub")])
     assert result.exit_code == 2
     assert "not writable" in result.output
 
@@ -132,7 +132,7 @@ def test_run_of_the_default_scene_completes_and_reports_its_volume(tmp_path):
     """The default deck (Guccione aorta, Technique 1) runs and writes the render it asks for."""
     import json
 
-    result = runner.invoke(app, ["run", str(DEFAULT_DECK), "--out", str(tmp_path / "out"), "--quiet"])
+    result = runner.invoke(app, ["run", str(ARTERY_DECK), "--out", str(tmp_path / "out"), "--quiet"])
     assert result.exit_code == 0, result.output
     assert list((tmp_path / "out" / "renders").glob("pressure_band_*.png"))
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())

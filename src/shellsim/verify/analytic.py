@@ -1,16 +1,17 @@
 """Semi-analytic references: closed-end inflation of an incompressible anisotropic tube,
 and the inflation of a neo-Hookean sphere (:func:`sphere_inflation_path`).
 
-Exact 3D solution (benchmarks.md, Tests 9 and 10) for the Guccione law of thesis Eq 4.2
-in cylindrical axes (t circumferential, z axial, r radial):
-
-    W = C1/2 (exp Q - 1),  Q = C2 E_tt^2 + C3 (E_zz^2 + E_rr^2)   (no shear strains here).
+Exact 3D solution (benchmarks.md, Tests 9 and 10) for a law without shear strains in
+cylindrical axes (t circumferential, z axial, r radial): the Guccione law of thesis Eq 4.2
+(:class:`Guccione`) or Holzapfel-Gasser-Ogden with two families at +-beta from the
+circumferential direction (:class:`HolzapfelGasserOgden`; the families' shears cancel).
 
 Deformation r(R) with r^2 = r_i^2 + (R^2 - R_i^2) / lambda_z, theta = Theta,
 z = lambda_z Z; stretches lambda_t = r / R, lambda_z, lambda_r = 1 / (lambda_t lambda_z).
 Cauchy stress differences D_t = s_tt - s_rr = lambda_t^2 S_tt - lambda_r^2 S_rr and
-D_z = s_zz - s_rr. Radial equilibrium with s_rr(r_i) = -P, s_rr(r_o) = 0 and the closed
-end's axial balance (wall force = pi r_i^2 P) give, with r dr = R dR / lambda_z,
+D_z = s_zz - s_rr, S the energy's second Piola stress. Radial equilibrium with
+s_rr(r_i) = -P, s_rr(r_o) = 0 and the closed end's axial balance (wall force = pi r_i^2 P)
+give, with r dr = R dR / lambda_z,
 
     P = int_{R_i}^{R_o} D_t R / (lambda_z r^2) dR,
     0 = int_{R_i}^{R_o} (2 D_z - D_t) R / lambda_z dR,
@@ -20,45 +21,91 @@ solved for (r_i, lambda_z) at each pressure, continuing from (R_i, 1) at P = 0.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.integrate import quad
 from scipy.optimize import root
 
 
-def _stress_differences(R, r_i, lam_z, R_i, C):
-    """(D_t, D_z) at material radius R."""
-    C1, C2, C3, _ = C
+@dataclass(frozen=True)
+class Guccione:
+    """W = C1/2 (exp Q - 1), Q = C2 E_tt^2 + C3 (E_zz^2 + E_rr^2) (no shear strains here);
+    C = (C1, C2, C3, C4), C1 in stress units, C4 (the shear weight) does no work here."""
+
+    C: tuple[float, float, float, float]
+
+    @property
+    def scale(self) -> float:
+        return self.C[0]
+
+    def stresses(self, E_t, E_z, E_r):
+        """(S_tt, S_zz, S_rr) at the principal Green-Lagrange strains."""
+        C1, C2, C3, _ = self.C
+        factor = C1 * np.exp(C2 * E_t**2 + C3 * (E_z**2 + E_r**2))
+        return factor * C2 * E_t, factor * C3 * E_z, factor * C3 * E_r
+
+
+@dataclass(frozen=True)
+class HolzapfelGasserOgden:
+    """W = mu/2 (I1 - 3) + sum over the families at +-beta_deg from the circumferential
+    direction of k1/(2 k2) (exp(k2 Ebar^2) - 1), Ebar = kappa (I1 - 3) + (1 - 3 kappa)
+    (I4 - 1), a family carrying nothing while I4 <= 1 (Gasser, Ogden & Holzapfel 2006)."""
+
+    mu: float
+    k1: float
+    k2: float
+    kappa: float
+    beta_deg: float
+
+    @property
+    def scale(self) -> float:
+        return self.mu
+
+    def stresses(self, E_t, E_z, E_r):
+        """(S_tt, S_zz, S_rr) = mu I + sum_f 2 psi (kappa I + (1 - 3 kappa) a_f a_f) at the
+        principal strains; both families stretch alike, psi = k1 Ebar exp(k2 Ebar^2)."""
+        c, s = np.cos(np.radians(self.beta_deg)), np.sin(np.radians(self.beta_deg))
+        fibre = c * c * E_t + s * s * E_z  # a.E a = (I4 - 1) / 2
+        ebar = 2.0 * self.kappa * (E_t + E_z + E_r) + 2.0 * (1.0 - 3.0 * self.kappa) * fibre
+        psi = np.where(fibre > 0.0, self.k1 * ebar * np.exp(self.k2 * ebar**2), 0.0)
+        dispersed, aligned = 4.0 * psi * self.kappa, 4.0 * psi * (1.0 - 3.0 * self.kappa)
+        return (self.mu + dispersed + aligned * c * c, self.mu + dispersed + aligned * s * s,
+                self.mu + dispersed)
+
+
+def _stress_differences(R, r_i, lam_z, R_i, law):
+    """(D_t, D_z, r) at material radius R."""
     r = np.sqrt(r_i**2 + (R**2 - R_i**2) / lam_z)
     lam_t = r / R
     lam_r = 1.0 / (lam_t * lam_z)
-    E_t, E_z, E_r = 0.5 * (lam_t**2 - 1), 0.5 * (lam_z**2 - 1), 0.5 * (lam_r**2 - 1)
-    scale = C1 * np.exp(C2 * E_t**2 + C3 * (E_z**2 + E_r**2))
-    S_t, S_z, S_r = scale * C2 * E_t, scale * C3 * E_z, scale * C3 * E_r
+    S_t, S_z, S_r = law.stresses(0.5 * (lam_t**2 - 1), 0.5 * (lam_z**2 - 1), 0.5 * (lam_r**2 - 1))
     return lam_t**2 * S_t - lam_r**2 * S_r, lam_z**2 * S_z - lam_r**2 * S_r, r
 
 
-def _residuals(unknowns, pressure, R_i, R_o, C):
-    """Both balances in units of C1, for the unknowns (r_i / R_i, lambda_z)."""
+def _residuals(unknowns, pressure, R_i, R_o, law):
+    """Both balances in units of the law's stress scale, for the unknowns (r_i / R_i,
+    lambda_z)."""
     r_i, lam_z = unknowns[0] * R_i, unknowns[1]
 
     def hoop(R):
-        D_t, _, r = _stress_differences(R, r_i, lam_z, R_i, C)
+        D_t, _, r = _stress_differences(R, r_i, lam_z, R_i, law)
         return D_t * R / (lam_z * r**2)
 
     def axial(R):
-        D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, C)
+        D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, law)
         return (2 * D_z - D_t) * R / lam_z
 
-    return [(quad(hoop, R_i, R_o, epsrel=1e-12)[0] - pressure) / C[0],
-            quad(axial, R_i, R_o, epsrel=1e-12)[0] / (R_o**2 * C[0])]
+    return [(quad(hoop, R_i, R_o, epsrel=1e-12)[0] - pressure) / law.scale,
+            quad(axial, R_i, R_o, epsrel=1e-12)[0] / (R_o**2 * law.scale)]
 
 
-def tube_inflation(pressures, inner_radius: float, wall_thickness: float, C) -> tuple[np.ndarray, np.ndarray]:
+def tube_inflation(pressures, inner_radius: float, wall_thickness: float, law) -> tuple[np.ndarray, np.ndarray]:
     """Inner radius r_i and axial stretch lambda_z of the closed-end tube at each pressure.
 
     pressures (m,) [stress units], increasing from 0 or above; inner_radius R_i and
-    wall_thickness H of the unloaded tube [length]; C = (C1, C2, C3, C4) of the Guccione
-    law (C1 in stress units; C4, the shear weight, does no work here). Returns
+    wall_thickness H of the unloaded tube [length]; ``law`` a :class:`Guccione` or
+    :class:`HolzapfelGasserOgden`. Returns
     (r_i (m,) [length], lambda_z (m,)). Pressures are reached by continuation in steps
     of at most 1/50 of the largest, each solve starting from the previous solution.
     """
@@ -72,7 +119,7 @@ def tube_inflation(pressures, inner_radius: float, wall_thickness: float, C) -> 
         target = pressures[index]
         steps = max(1, int(np.ceil((target - done) / (top / 50))))
         for pressure in np.linspace(done, target, steps + 1)[1:]:
-            solution = root(_residuals, guess, args=(pressure, R_i, R_o, C), method="hybr", tol=1e-13)
+            solution = root(_residuals, guess, args=(pressure, R_i, R_o, law), method="hybr", tol=1e-13)
             # 'no good progress' at round-off level is convergence: judge by the residual
             if np.abs(solution.fun).max() > 1e-10:
                 raise RuntimeError(f"tube_inflation: no solution at P = {pressure:g}: {solution.message}")
@@ -82,19 +129,19 @@ def tube_inflation(pressures, inner_radius: float, wall_thickness: float, C) -> 
     return out_r, out_z
 
 
-def through_wall_stresses(pressure: float, R, inner_radius: float, wall_thickness: float, C):
+def through_wall_stresses(pressure: float, R, inner_radius: float, wall_thickness: float, law):
     """Cauchy stresses (s_rr, s_tt, s_zz) (each like R) at material radii R through the
     wall at one pressure: s_rr(R) = -int_R^{R_o} D_t R' / (lambda_z r^2) dR'."""
     R_i, R_o = inner_radius, inner_radius + wall_thickness
-    (r_i,), (lam_z,) = tube_inflation([pressure], R_i, wall_thickness, C)
+    (r_i,), (lam_z,) = tube_inflation([pressure], R_i, wall_thickness, law)
     R = np.atleast_1d(np.asarray(R, dtype=float))
 
     def hoop(Rp):
-        D_t, _, r = _stress_differences(Rp, r_i, lam_z, R_i, C)
+        D_t, _, r = _stress_differences(Rp, r_i, lam_z, R_i, law)
         return D_t * Rp / (lam_z * r**2)
 
     s_rr = np.array([-quad(hoop, Ri, R_o, epsrel=1e-12)[0] for Ri in R])
-    D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, C)
+    D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, law)
     return s_rr, s_rr + D_t, s_rr + D_z
 
 

@@ -19,7 +19,7 @@ from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
 from .element.frames import initial_fibre_frame
 from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
-from .errors import MeshError, NotYetAvailable
+from .errors import NotYetAvailable
 from .loads.edge_pressure import EDGE_DN, EDGE_N, EDGE_W
 from .loads.pressure import pressure_forces
 from .materials.laws import law_of
@@ -135,11 +135,10 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
-    a3 the lamina normal g_r x g_s / |.|, a1 the preferred direction projected on the
-    lamina (circumferential about ``axes.axis`` for cylindrical axes or about the nearest
-    segment of a centreline, ``axes.direction`` for fixed ones, the element's vector ``axes.field`` from the mesh file, g_r for an
-    isotropic law or where the preferred direction is normal to the lamina, e.g. on a
-    tube's axis), then turned about a3 by the layer's ``axes.angle_deg``; a2 = a3 x a1."""
+    a3 the lamina normal g_r x g_s / |.|, a1 the axes' preferred direction projected on
+    the lamina (:class:`shellsim.deck.axes.TurnedAxes`; g_r for an isotropic law or where
+    the preferred direction is normal to the lamina, e.g. on a tube's axis), then turned
+    about a3 by the layer's ``axes.angle_deg``; a2 = a3 x a1."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     turns = np.zeros(len(tz)) if axes is None else axes.angles(tz)
     for k, t in enumerate(tz):
@@ -147,16 +146,7 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
         g_r, g_s = jac[..., 0], jac[..., 1]
         normal = np.cross(g_r, g_s)
         normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-        if axes is None:
-            preferred = g_r
-        elif axes.kind == "cylindrical":
-            preferred = np.cross(np.asarray(axes.axis, dtype=float), position - np.asarray(axes.origin))
-        elif axes.kind == "centreline":
-            preferred = axes.preferred(position)
-        elif axes.kind == "mesh":
-            preferred = np.broadcast_to(_mesh_vectors(mesh, axes.field)[:, None], g_r.shape)
-        else:
-            preferred = np.broadcast_to(np.asarray(axes.direction, dtype=float), g_r.shape)
+        preferred = g_r if axes is None else axes.preferred(position, mesh.cell_vectors)
         a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
         size = np.linalg.norm(a1, axis=-1, keepdims=True)
         fallback = g_r - np.sum(g_r * normal, axis=-1, keepdims=True) * normal
@@ -165,15 +155,6 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
         a1 = np.cos(turns[k]) * a1 + np.sin(turns[k]) * np.cross(normal, a1)
         out[:, :, k] = np.stack([a1, np.cross(normal, a1), normal], axis=-2)
     return out
-
-
-def _mesh_vectors(mesh: Mesh, name: str) -> np.ndarray:
-    """The mesh's per-element vectors ``name`` (ne, 3), or a message saying what there is."""
-    if name not in mesh.cell_vectors:
-        there = ", ".join(f"'{n}'" for n in mesh.cell_vectors) or "none (only a mesh file's cell data can give them)"
-        raise MeshError(f"material.axes.field = '{name}': the mesh has no per-element vectors of that name; "
-                        f"it has {there}")
-    return mesh.cell_vectors[name]
 
 
 def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
@@ -207,7 +188,8 @@ def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) inverses of dy/d(r, s, t) on the initial configuration."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     for k, t in enumerate(tz):
-        out[:, :, k] = np.linalg.inv(layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)[1])
+        jacobian = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)[1]
+        out[:, :, k] = np.linalg.inv(jacobian)
     return out
 
 

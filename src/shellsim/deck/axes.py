@@ -9,6 +9,7 @@ from typing import Annotated, ClassVar, Literal, Union
 import numpy as np
 from pydantic import Field, field_validator, model_validator
 
+from ..errors import MeshError
 from .types import Name, Section, Vec3
 
 #: An angle of material axis 1 about the lamina normal (degrees).
@@ -18,7 +19,11 @@ Angle = Annotated[float, Field(strict=True, ge=-180.0, le=180.0, allow_inf_nan=F
 class TurnedAxes(Section):
     """Axis 1 turned about the lamina normal, toward axis 2, by ``angle_deg``: one angle,
     or a list of angles at evenly spaced depths from the bottom face to the top face
-    (linear between them), e.g. a vessel wall's helical fibres [-60, 60]."""
+    (linear between them), e.g. a vessel wall's helical fibres [-60, 60].
+
+    Each kind gives ``preferred(position, cell_vectors)``: the direction (ne, q, 3) that
+    axis 1 follows at the points ``position`` (ne, q, 3), before it is projected on the
+    lamina; ``cell_vectors`` are the mesh's per-element vectors by name."""
 
     angle_deg: Union[Angle, Annotated[list[Angle], Field(min_length=2)]] = 0.0
 
@@ -44,6 +49,10 @@ class CylindricalAxes(TurnedAxes):
     def _nonzero(cls, v: tuple[float, float, float]) -> tuple[float, float, float]:
         return _nonzero_vector(v)
 
+    def preferred(self, position: np.ndarray, cell_vectors: dict) -> np.ndarray:
+        """axis x (p - origin): circumferential."""
+        return np.cross(np.asarray(self.axis, dtype=float), position - np.asarray(self.origin))
+
 
 class FixedAxes(TurnedAxes):
     """Material axis 1 along ``direction`` projected on the lamina; 3 is the lamina normal."""
@@ -55,6 +64,10 @@ class FixedAxes(TurnedAxes):
     @classmethod
     def _nonzero(cls, v: tuple[float, float, float]) -> tuple[float, float, float]:
         return _nonzero_vector(v)
+
+    def preferred(self, position: np.ndarray, cell_vectors: dict) -> np.ndarray:
+        """``direction`` everywhere."""
+        return np.broadcast_to(np.asarray(self.direction, dtype=float), position.shape)
 
 
 class CentrelineAxes(TurnedAxes):
@@ -72,9 +85,8 @@ class CentrelineAxes(TurnedAxes):
             raise ValueError("consecutive centreline points must differ")
         return points
 
-    def preferred(self, position: np.ndarray) -> np.ndarray:
-        """t x (p - c) at positions p (..., 3): c the nearest point of the centreline,
-        t its segment's unit direction."""
+    def preferred(self, position: np.ndarray, cell_vectors: dict) -> np.ndarray:
+        """t x (p - c): c the centreline's point nearest p, t its segment's unit direction."""
         ends = np.asarray(self.points, dtype=float)
         start, step = ends[:-1], np.diff(ends, axis=0)  # (S, 3)
         p = position[..., None, :]
@@ -92,6 +104,14 @@ class MeshAxes(TurnedAxes):
 
     kind: Literal["mesh"]
     field: Name
+
+    def preferred(self, position: np.ndarray, cell_vectors: dict) -> np.ndarray:
+        """The element's vector ``field`` at each of its points."""
+        if self.field not in cell_vectors:
+            there = ", ".join(f"'{n}'" for n in cell_vectors) or "none (only a mesh file's cell data can give them)"
+            raise MeshError(f"material.axes.field = '{self.field}': the mesh has no per-element vectors of that "
+                            f"name; it has {there}")
+        return np.broadcast_to(cell_vectors[self.field][:, None], position.shape)
 
 
 Axes = Annotated[Union[CylindricalAxes, CentrelineAxes, FixedAxes, MeshAxes], Field(discriminator="kind")]

@@ -31,30 +31,24 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     director = thickness = None
     surface_normals: list = []
     cell_vectors: dict[str, np.ndarray] = {}
-    if g.builder == "file" and g.surface:
+    remeshed = g.builder == "file" and g.surface
+    if remeshed:
         from .session import gmsh_session
         from .surfaces import boundary_loops, remesh
 
         path = resolve_mesh_path(deck, base_dir)
+        source = f"surface file '{path}'"
         with gmsh_session(name="surface") as gmsh:
             x, conn = remesh(gmsh, path, g.element_size)
         sets = boundary_loops(x, conn, g.boundaries, path)
-        problems = check_references(deck, {name: s.kind for name, s in sets.items()})
-        if problems:
-            raise MeshError(f"the deck names sets that remeshed surface '{path}' does not have "
-                            f"(it has {', '.join(sets) or 'no open boundary'}):\n"
-                            + "\n".join(f"  - {p}" for p in problems))
         preferred = x[conn[:, 8]] - x.mean(axis=0)  # outward, for a vessel
     elif g.builder == "file":
         from .importing import read_mesh
 
         path = resolve_mesh_path(deck, base_dir)
+        source = f"mesh file '{path}'"
         imported = read_mesh(path)
         x, conn, sets = imported.x, imported.conn, imported.sets
-        problems = check_references(deck, {name: s.kind for name, s in sets.items()})
-        if problems:
-            raise MeshError(f"the deck names sets that mesh file '{path}' does not have:\n"
-                            + "\n".join(f"  - {p}" for p in problems))
         director, thickness, cell_vectors = imported.director, imported.thickness, imported.cell_vectors
         preferred = director[conn[:, 8]] if director is not None else None
     else:
@@ -62,15 +56,21 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
         from .gmsh_extract import extract
         from .session import gmsh_session
 
+        source = f"builder '{g.builder}'"
         with gmsh_session(name=g.builder) as gmsh:
             sketch = builders.Sketch(gmsh)
             hint = builders.BUILDERS[g.builder](sketch, g, deck.mesh, deck.section.thickness)
             sketch.finish()
-            x, conn, sets, surface_normals = extract(gmsh, f"builder '{g.builder}'")
+            x, conn, sets, surface_normals = extract(gmsh, source)
         if g.builder == "twisted_strip":
             x, normals = builders.twist_onto_helicoid(x, g)
             surface_normals = [(np.arange(len(x)), normals)]
         preferred = hint(x[conn[:, 8]])
+    if g.builder == "file":  # a builder makes the sets its deck model declares (tested)
+        problems = check_references(deck, {name: s.kind for name, s in sets.items()})
+        if problems:
+            raise MeshError(f"the deck names sets that {source} does not have:\n"
+                            + "\n".join(f"  - {p}" for p in problems))
     conn = orient_consistently(x, conn, preferred)
     if director is None:
         director = combine_surface_normals(averaged_directors(x, conn), surface_normals)
@@ -79,10 +79,8 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     all_elements = np.arange(len(conn))
     sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
     # on a remeshed surface nobody knows where the nodes are: the nearest within half an element
-    reach = 0.5 * g.element_size if g.builder == "file" and g.surface else None
-    sets = sets | snap_points(x, deck.mesh.points, reach)
+    sets = sets | snap_points(x, deck.mesh.points, 0.5 * g.element_size if remeshed else None)
     mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors)
-    source = f"{'surface' if g.surface else 'mesh'} file '{path}'" if g.builder == "file" else f"builder '{g.builder}'"
     check_mesh(mesh, source, deck.section.points_through_thickness)
     return mesh
 

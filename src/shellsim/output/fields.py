@@ -21,7 +21,8 @@ import numpy as np
 
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import gauss_rule, shape
-from ..model import Model
+from ..materials.laws import LAWS
+from ..model import Model, layer_geometry
 from ..solver.simulation import Simulation
 
 POINT_FIELDS = ("displacement", "director", "thickness")
@@ -137,20 +138,19 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
-def fibre_directions(sim: Simulation) -> list[np.ndarray]:
-    """Each fibre family's current unit direction at every integration point, (ne, nq,
-    nt, 3) per family: its initial direction (the law's ``fibres`` in the initial material
-    frame) carried by the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1."""
-    from ..materials.laws import LAWS
-    from ..model import layer_geometry
-
+def fibre_directions(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
+    """Each fibre family's current unit direction at every in-plane integration point of
+    the ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family:
+    its initial direction (the law's ``fibres`` in the initial material frame) carried by
+    the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1."""
     model, state, rule = sim.model, sim.state, sim.model.rule
     nq = len(rule.wq)
-    F = np.empty((model.n_elements, nq, len(rule.tz), 3, 3))
-    for k, t in enumerate(rule.tz):
-        jac = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], t)[1]
-        F[:, :, k] = jac @ model.body.jac0_inv[:, :nq, k]
-    frames = model.material.axes0  # rows: material axes 1, 2, 3
+    F = np.empty((model.n_elements, nq, len(layers), 3, 3))
+    for column, k in enumerate(layers):
+        jac = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq],
+                             rule.tz[k])[1]
+        F[:, :, column] = jac @ model.body.jac0_inv[:, :nq, k]
+    frames = model.material.axes0[:, :, layers]  # rows: material axes 1, 2, 3
     directions = []
     for c, s in LAWS[model.material.law].fibres(model.material.params):
         current = np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
@@ -196,10 +196,9 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
-    if FIBRES in fields:
-        for family, directions in enumerate(fibre_directions(sim), start=1):
-            if mesh.solid:
-                cell_data[f"{FIBRE_PREFIX}{family}"] = directions.transpose(0, 2, 1, 3).reshape(-1, 3)
-            else:  # the shell view shows the middle layer's fibres
-                cell_data[f"{FIBRE_PREFIX}{family}"] = directions[:, :, len(model.rule.tz) // 2].reshape(-1, 3)
+    if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
+        nt = len(model.rule.tz)
+        for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),
+                                            start=1):
+            cell_data[f"{FIBRE_PREFIX}{family}"] = directions.transpose(0, 2, 1, 3).reshape(-1, 3)
     return point_data, cell_data

@@ -165,7 +165,7 @@ class Drawn(NamedTuple):
     are drawn, or None, and each fibre family's cell vectors (C, 3)."""
 
     initial: np.ndarray | None = None
-    fibres: list[np.ndarray] = []
+    fibres: tuple[np.ndarray, ...] = ()
 
 
 NO_OVERLAYS = Overlays()
@@ -202,7 +202,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     for index, (point_data, cell_data), (values, on_cells, _) in zip(indices, frames, picked):
         path = out_dir / f"{stem}_{index:04d}.png"
         deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
-        fibres = [v for name, v in sorted(cell_data.items()) if name.startswith(FIBRE_PREFIX)] if overlays.fibres else []
+        fibres = tuple(v for name, v in sorted(cell_data.items()) if overlays.fibres and name.startswith(FIBRE_PREFIX))
         _render_frame(deformed, series, Colouring(values, on_cells, bar, (low, high)), view, size,
                       f"{title}\nt = {series.times[index]:.6g}", path,
                       Drawn(series.points if overlays.outline else None, fibres))
@@ -245,27 +245,27 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
         grid.point_data["values"] = values
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
-    field_actor = plotter.add_mesh(grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
-                     scalar_bar_args={"title": bar, "color": "black", "vertical": False, "fmt": "%.4g",
-                                      "position_x": 0.2, "position_y": 0.04, "width": 0.6, "height": 0.07,
-                                      "title_font_size": max(10, size[1] // 40),
-                                      "label_font_size": max(8, size[1] // 50)})
+    field_actor = plotter.add_mesh(
+        grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
+        scalar_bar_args={"title": bar, "color": "black", "vertical": False, "fmt": "%.4g", "position_x": 0.2,
+                         "position_y": 0.04, "width": 0.6, "height": 0.07,
+                         "title_font_size": max(10, size[1] // 40), "label_font_size": max(8, size[1] // 50)})
+    field_actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # lines on the surface drawn in front
     rings = np.arange(0, len(points), 16)[:, None] + ELEMENT_RING[None]
     lines = np.hstack([np.full((len(rings), 1), len(ELEMENT_RING)), rings]).ravel()
     plotter.add_mesh(pv.PolyData(points, lines=lines), color="black", line_width=2)
     if drawn.initial is not None:
         plotter.add_mesh(pv.PolyData(drawn.initial, lines=lines), color="#808080", line_width=1)
-    field_actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # lines on the surface drawn in front
     if drawn.fibres:  # one line per element (and layer): through its centre sub-cell, q = 4
         middle = np.arange(len(series.cells)) % 9 == 4
         faces = series.cells[middle, 4:] if series.cell_type == "hexahedron" else series.cells[middle]  # top faces
         centres = points[faces].mean(axis=1)
         length = 1.2 * np.median(np.linalg.norm(points[faces[:, 2]] - points[faces[:, 0]], axis=1))
+        count = len(centres)
+        segments = np.column_stack([np.full(count, 2), np.arange(count), np.arange(count) + count]).ravel()
         for family, every in enumerate(drawn.fibres):
             directions = every[middle]
             ends = np.concatenate([centres - length * directions, centres + length * directions])
-            segments = np.column_stack([np.full(len(centres), 2), np.arange(len(centres)),
-                                        np.arange(len(centres)) + len(centres)]).ravel()
             plotter.add_mesh(pv.PolyData(ends, lines=segments), color=FIBRE_COLOURS[family % len(FIBRE_COLOURS)],
                              line_width=2)
     plotter.add_text(caption, position="upper_left", font_size=max(8, size[1] // 70), color="black")

@@ -2,8 +2,8 @@
 every law of :data:`shellsim.materials.laws.LAWS`, each defined in its law's file.
 
 Incompressible models impose J = 1 exactly through the lamina normal strain (thesis
-Technique 1), so they take no bulk modulus or Poisson ratio. Parameter names follow the thesis; Guccione's C1..C4 are LS-DYNA MAT_128's
-C, B1, B2, B3.
+Technique 1), so they take no bulk modulus or Poisson ratio. Parameter names follow the
+thesis; Guccione's C1..C4 are LS-DYNA MAT_128's C, B1, B2, B3.
 """
 
 from __future__ import annotations

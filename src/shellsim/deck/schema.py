@@ -420,8 +420,8 @@ class Output(Section):
             raise ValueError("give either 'interval' or 'times', not both")
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
             raise ValueError(f"'times' must be strictly increasing, got {self.times}")
-        unwritten = sorted({r.field for r in self.render} - set(self.fields)
-                           | ({"fibres"} - set(self.fields) if any(r.fibres for r in self.render) else set()))
+        drawn = {r.field for r in self.render} | {"fibres" for r in self.render if r.fibres}
+        unwritten = sorted(drawn - set(self.fields))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
         duplicates = repeated([p.name for p in self.probe])

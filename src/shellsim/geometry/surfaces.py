@@ -23,6 +23,8 @@ import numpy as np
 
 from ..errors import MeshError, place
 from ..mesh import EDGES, NamedSet
+from .gmsh_extract import extract
+from .importing import read_meshio
 
 #: Dihedral angle above which gmsh splits the surface into patches (degrees): a ridge
 #: sharper than this stays a ridge.
@@ -33,8 +35,6 @@ LOOP_PREFIX = "open_"
 
 def read_triangles(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """Points (n, 3) and triangles (m, 3) of a surface file, unused points dropped."""
-    from .importing import read_meshio
-
     surface = read_meshio(path)
     blocks = [np.asarray(b.data, dtype=np.int64) for b in surface.cells if b.type == "triangle"]
     others = sorted({b.type for b in surface.cells if b.type not in ("triangle", "vertex", "line")})
@@ -55,8 +55,6 @@ def read_triangles(path: Path) -> tuple[np.ndarray, np.ndarray]:
 def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     """Quad9 nodes (n, 3) and connectivity (ne, 9) of the surface in ``path`` remeshed
     with elements of about ``size``, inside a gmsh session."""
-    from .gmsh_extract import extract
-
     points, triangles = read_triangles(path)
     surface = gmsh.model.addDiscreteEntity(2)
     gmsh.model.mesh.addNodes(2, surface, np.arange(1, len(points) + 1), points.ravel())

@@ -83,20 +83,24 @@ def _stress_differences(R, r_i, lam_z, R_i, law):
     return lam_t**2 * S_t - lam_r**2 * S_r, lam_z**2 * S_z - lam_r**2 * S_r, r
 
 
+def _radial_gradient(R, r_i, lam_z, R_i, law):
+    """d s_rr / dR = D_t R / (lambda_z r^2) at material radius R: the integrand of the
+    radial balance."""
+    D_t, _, r = _stress_differences(R, r_i, lam_z, R_i, law)
+    return D_t * R / (lam_z * r**2)
+
+
 def _residuals(unknowns, pressure, R_i, R_o, law):
     """Both balances in units of the law's stress scale, for the unknowns (r_i / R_i,
     lambda_z)."""
     r_i, lam_z = unknowns[0] * R_i, unknowns[1]
 
-    def hoop(R):
-        D_t, _, r = _stress_differences(R, r_i, lam_z, R_i, law)
-        return D_t * R / (lam_z * r**2)
-
     def axial(R):
         D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, law)
         return (2 * D_z - D_t) * R / lam_z
 
-    return [(quad(hoop, R_i, R_o, epsrel=1e-12)[0] - pressure) / law.scale,
+    hoop = quad(_radial_gradient, R_i, R_o, args=(r_i, lam_z, R_i, law), epsrel=1e-12)[0]
+    return [(hoop - pressure) / law.scale,
             quad(axial, R_i, R_o, epsrel=1e-12)[0] / (R_o**2 * law.scale)]
 
 
@@ -135,12 +139,7 @@ def through_wall_stresses(pressure: float, R, inner_radius: float, wall_thicknes
     R_i, R_o = inner_radius, inner_radius + wall_thickness
     (r_i,), (lam_z,) = tube_inflation([pressure], R_i, wall_thickness, law)
     R = np.atleast_1d(np.asarray(R, dtype=float))
-
-    def hoop(Rp):
-        D_t, _, r = _stress_differences(Rp, r_i, lam_z, R_i, law)
-        return D_t * Rp / (lam_z * r**2)
-
-    s_rr = np.array([-quad(hoop, Ri, R_o, epsrel=1e-12)[0] for Ri in R])
+    s_rr = np.array([-quad(_radial_gradient, Ri, R_o, args=(r_i, lam_z, R_i, law), epsrel=1e-12)[0] for Ri in R])
     D_t, D_z, _ = _stress_differences(R, r_i, lam_z, R_i, law)
     return s_rr, s_rr + D_t, s_rr + D_z
 

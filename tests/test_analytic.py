@@ -73,7 +73,7 @@ def test_the_tube_references_hgo_stress_is_the_law_of_the_kernels():
     """The semi-analytic tube's HGO stresses (circumferential, axial, radial) equal the
     compiled law's S^w in material axes (1 circumferential, 2 axial, 3 radial) at
     principal strains, fibres stretched and shortened: two separate writings agree."""
-    from shellsim.element.lanes import LANES
+    from shellsim.lanes import LANES
     from shellsim.materials import hgo
     from shellsim.verify.analytic import HolzapfelGasserOgden
 

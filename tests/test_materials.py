@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from shellsim.bundles import Material
-from shellsim.element.lanes import LANES
+from shellsim.lanes import LANES
 from shellsim.materials import zero_normal_stress as zns
 from shellsim.materials.laws import LAWS, energy, law_of
 
@@ -244,7 +244,7 @@ def test_every_deck_model_of_a_law_is_a_deck_material():
     """The registry and the deck agree: the deck accepts each law's models."""
     from shellsim.deck.material import MATERIALS
 
-    from shellsim.deck.types import tag_of
+    from shellsim.table_types import tag_of
 
     for law in LAWS:
         for model in law.MODELS:

@@ -1,6 +1,7 @@
 """The named bundles the compiled layer receives: typed tuples of arrays, built once by
 :func:`shellsim.model.build_model` (the scene) or :class:`shellsim.solver.simulation.Simulation`
-(the state), and passed whole to every compiled function.
+(the state), and passed whole to every compiled function. The loads' bundles belong to
+their kinds (:mod:`shellsim.loads`).
 
 numba compiles a ``NamedTuple`` into a struct whose fields are read by name, and its
 on-disk cache keeps working across processes, so no compiled function depends on the
@@ -90,43 +91,6 @@ class Curves(NamedTuple):
     extrap: np.ndarray
 
 
-class NodalLoads(NamedTuple):
-    """Dead nodal vectors (forces or moments): vectors (L, n, 3), each scaled by its curve
-    (L,) (index into :class:`Curves`, -1 constant)."""
-
-    vectors: np.ndarray
-    curve: np.ndarray
-
-
-class PressureLoads(NamedTuple):
-    """Follower pressure on element faces (P,): elements, face (-1 bottom, 0 mid, +1 top),
-    value [force/length^2], curve."""
-
-    elements: np.ndarray
-    face: np.ndarray
-    value: np.ndarray
-    curve: np.ndarray
-
-
-class EdgePressureLoads(NamedTuple):
-    """Pressure on edge faces (E,): edges (E, 3) node triples, outward (+1 or -1, the sign
-    that makes tangent x director point out), value [force/length^2], curve."""
-
-    edges: np.ndarray
-    outward: np.ndarray
-    value: np.ndarray
-    curve: np.ndarray
-
-
-class Loads(NamedTuple):
-    """Every external load of a scene, by kind."""
-
-    force: NodalLoads
-    moment: NodalLoads
-    pressure: PressureLoads
-    edge_pressure: EdgePressureLoads
-
-
 class Prescribed(NamedTuple):
     """Prescribed translations (P,): x[node, axis] = x0 + value * curve(t)."""
 
@@ -156,7 +120,7 @@ class Model(NamedTuple):
     rule: Rule
     body: Body
     material: Material
-    loads: Loads
+    loads: tuple  # shellsim.loads.Loads: one bundle per load kind, made from the registry
     curves: Curves
     constraints: Constraints
     x0: np.ndarray

@@ -62,10 +62,6 @@ class StudyError(ShellsimError):
     """A study that cannot go on (its scheduler does not answer) or a job whose worker died."""
 
 
-class NotYetAvailable(ShellsimError):
-    """A command whose work is planned but not built yet."""
-
-
 class Terminated(KeyboardInterrupt):
     """SIGTERM (what schedulers and ``timeout`` send), handled like Ctrl-C: the run stops,
     its files are closed and its summary is marked interrupted."""

@@ -16,6 +16,8 @@ from .errors import MeshError, id_list, place
 
 #: Node permutation that reverses an element's orientation (swaps r and s).
 FLIP = np.array([0, 3, 2, 1, 7, 6, 5, 4, 8])
+#: The shell's faces by name, as thickness coordinates.
+FACES = {"bottom": -1, "mid": 0, "top": 1}
 
 
 @dataclass(frozen=True)
@@ -45,6 +47,8 @@ class Mesh:
     sets : name -> NamedSet.
     cell_vectors : name -> (n_elements, 3) float — per-element vectors a mesh file carries
         (e.g. fibre directions).
+    point_fields, cell_fields : name -> (n_nodes,) or (n_elements,) float — scalar fields a
+        mesh file carries (e.g. a wall-pressure map for a mapped pressure).
     """
 
     x: np.ndarray
@@ -53,6 +57,8 @@ class Mesh:
     thickness: np.ndarray
     sets: dict[str, NamedSet] = field(default_factory=dict)
     cell_vectors: dict[str, np.ndarray] = field(default_factory=dict)
+    point_fields: dict[str, np.ndarray] = field(default_factory=dict)
+    cell_fields: dict[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def n_nodes(self) -> int:
@@ -167,18 +173,31 @@ def body_jacobians(x: np.ndarray, conn: np.ndarray, director: np.ndarray, thickn
     """
     rs, _ = gauss_rule_2d(n_inplane)
     t, _ = gauss_rule(n_thick)
-    n = shape(rs)  # (q, 9)
     dn = shape_derivatives(rs)  # (q, 9, 2)
-    xe = x[conn]  # (ne, 9, 3)
-    fibre = (0.5 * thickness[:, None] * director)[conn]  # (ne, 9, 3)
-    g = np.einsum("qad,eai->eqdi", dn, xe)  # (ne, q, 2, 3)
-    gf = np.einsum("qad,eai->eqdi", dn, fibre)  # (ne, q, 2, 3)
-    f = np.einsum("qa,eai->eqi", n, fibre)  # (ne, q, 3) = dx/dt
-    dets = []
-    for tk in t:
-        gr, gs = g[:, :, 0] + tk * gf[:, :, 0], g[:, :, 1] + tk * gf[:, :, 1]
-        dets.append(np.einsum("eqi,eqi->eq", np.cross(gr, gs), f))
-    return np.stack(dets, axis=-1)
+    layers = [layer_geometry(x, director, thickness, conn, shape(rs), dn[:, :, 0], dn[:, :, 1], tk)[1] for tk in t]
+    return np.stack([np.linalg.det(jacobian) for jacobian in layers], axis=-1)
+
+
+def layer_geometry(x: np.ndarray, d: np.ndarray, h: np.ndarray, conn: np.ndarray, N, dNr, dNs,
+                   t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (ne, q, 3) and Jacobians dy/d(r, s, t) (ne, q, 3, 3, columns) of the
+    points (N, dNr, dNs: (q, 9)) on the layer at thickness coordinate t, for mid-surface
+    nodes x (n, 3), directors d (n, 3) and fibre lengths h (n,)."""
+    xe, fe = x[conn], (0.5 * h[:, None] * d)[conn]
+    pos = xe + t * fe
+    jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
+                    np.einsum("qa,eai->eqi", N, fe)], axis=-1)
+    return np.einsum("qa,eai->eqi", N, pos), jac
+
+
+def inverse_jacobians(mesh: Mesh, N, dNr, dNs, tz) -> np.ndarray:
+    """(ne, q, nt, 3, 3) inverses of dy/d(r, s, t) on the initial shape at the points
+    (N, dNr, dNs: (q, 9)) of the layers tz (nt,)."""
+    out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
+    for k, t in enumerate(tz):
+        jacobian = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)[1]
+        out[:, :, k] = np.linalg.inv(jacobian)
+    return out
 
 
 def check_mesh(mesh: Mesh, source: str, n_thick: int = 2) -> None:

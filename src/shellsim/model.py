@@ -4,30 +4,25 @@ see, and nothing else.
 Boundary conditions become, per node, a projector on the translational velocity and a
 free/fixed flag for each of the two rotational DOFs, with the nodal fibre frame turned so
 that a director constraint is one of those DOFs (symmetry plane or edge support: e1f is
-the plane's normal, whose rotation is fixed). Loads become tables: dead nodal vectors
-(edge, point, body, dead pressure) and follower pressures evaluated every step, each with
-the index of its time curve (-1: constant).
+the plane's normal, whose rotation is fixed). Loads become the tables of their kinds
+(:func:`shellsim.loads.build_loads`), each with the index of its time curve.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .bundles import (Body, Constraints, Curves, EdgePressureLoads, Loads, Material, Model, NodalLoads, Prescribed,
-                      PressureLoads, Rule, Shape, slots_by_node)
+from .bundles import Body, Constraints, Curves, Material, Model, Prescribed, Rule, Shape, slots_by_node
 from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
 from .element.frames import initial_fibre_frame
-from .element.shape import EDGES, NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
-from .errors import NotYetAvailable
-from .loads.edge_pressure import EDGE_DN, EDGE_N, EDGE_W
-from .loads.pressure import pressure_forces
+from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
+from .loads import LoadScene, build_loads
 from .materials.laws import law_of
 from .materials.linear import reduced_lamina_matrix
-from .mesh import Mesh
+from .mesh import Mesh, inverse_jacobians, layer_geometry
 
 AXES = {"x": 0, "y": 1, "z": 2}
-FACES = {"bottom": -1, "mid": 0, "top": 1}
 
 
 def integration_rule(points_through_thickness: int, plane_strain: bool = False) -> Rule:
@@ -84,21 +79,23 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     rule = integration_rule(deck.section.points_through_thickness, deck.section.plane_strain)
     conn = mesh.conn.astype(np.int64)
     node_slots, slots = slots_by_node(conn, mesh.n_nodes)
-    body = Body(conn=conn, jac0_inv=_initial_inverse_jacobians(mesh, rule.N, rule.dNr, rule.dNs, rule.tz),
+    body = Body(conn=conn, jac0_inv=inverse_jacobians(mesh, rule.N, rule.dNr, rule.dNs, rule.tz),
                 h0=mesh.thickness.copy(), node_slots=node_slots, slots=slots)
     constraints, e1f0 = _boundary_conditions(deck, mesh)
-    curve_names = list(deck.curves)
+    curves = _curve_tables(deck)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
+    loads = build_loads(deck.load, LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
+                                             curve_index=deck.curve_index))
     return Model(
-        rule=rule, body=body, material=_material(deck, mesh, rule), loads=_loads(deck, mesh, curve_names, rule, body, initial),
-        curves=_curve_tables(deck, curve_names), constraints=constraints,
-        x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0, density=deck.material.density, mass=deck.solver.mass,
-        damping=deck.solver.damping,
+        rule=rule, body=body, material=_material(deck, mesh, rule), loads=loads, curves=curves,
+        constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0,
+        density=deck.material.density, mass=deck.solver.mass, damping=deck.solver.damping,
     )
 
 
 def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
-    """The kernels' :class:`~shellsim.bundles.Material`.
+    """The kernels' :class:`~shellsim.bundles.Material` (the deck has refused the paths
+    the element cannot run).
 
     A linear elastic material without a technique is the small-strain path, with
     Technique 1 it is St. Venant-Kirchhoff; a hyperelastic one runs Technique 1 (total
@@ -109,23 +106,15 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
     nq = len(rule.wq)
     no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
     constant = dict(law=0, params=np.zeros(1), incompressible=False, axes0=no_axes, normal_ratio=0.0)
-    if not material.HYPERELASTIC and section.technique is None:
+    if section.technique is None:
         return Material(C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), technique=0,
                         incremental=section.formulation == "incremental", thickness_update=False, **constant)
-    if section.plane_strain:
-        raise NotYetAvailable("section.plane_strain with a large-strain technique is not available; "
-                              "plane strain is a small-strain section (Test 7)")
-    if not material.HYPERELASTIC and section.technique in (2, 3):
+    if section.technique in (2, 3):
         # constant tensor, stresses accumulated in the lamina frame from each step's
         # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
         return Material(C=reduced_lamina_matrix(material.E, material.nu), technique=section.technique,
                         incremental=True, thickness_update=deck.thickness_update,
                         **(constant | {"normal_ratio": material.nu / (1.0 - material.nu)}))
-    if section.technique not in (None, 1):
-        raise NotYetAvailable(f"section.technique = {section.technique}: a hyperelastic material runs "
-                              "Technique 1; Techniques 2 and 3 take a linear elastic material")
-    if section.formulation != "total":
-        raise NotYetAvailable("Technique 1 runs in the total formulation (section.formulation = 'total')")
     code, law = law_of(material.model)
     axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
     return Material(law=code, params=law.parameters(material), incompressible=law.INCOMPRESSIBLE, C=np.zeros((5, 5)),
@@ -136,7 +125,7 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
     a3 the lamina normal g_r x g_s / |.|, a1 the axes' preferred direction projected on
-    the lamina (:class:`shellsim.deck.axes.TurnedAxes`; g_r for an isotropic law or where
+    the lamina (:class:`shellsim.materials.axes.TurnedAxes`; g_r for an isotropic law or where
     the preferred direction is normal to the lamina, e.g. on a tube's axis), then turned
     about a3 by the layer's ``axes.angle_deg``; a2 = a3 x a1."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
@@ -172,27 +161,6 @@ def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(rs)), rs])
 
 
-def layer_geometry(x: np.ndarray, d: np.ndarray, h: np.ndarray, conn: np.ndarray, N, dNr, dNs,
-                   t: float) -> tuple[np.ndarray, np.ndarray]:
-    """Positions (ne, q, 3) and Jacobians dy/d(r, s, t) (ne, q, 3, 3, columns) of the
-    points (N, dNr, dNs: (q, 9)) on the layer at thickness coordinate t, for mid-surface
-    nodes x (n, 3), directors d (n, 3) and fibre lengths h (n,)."""
-    xe, fe = x[conn], (0.5 * h[:, None] * d)[conn]
-    pos = xe + t * fe
-    jac = np.stack([np.einsum("qa,eai->eqi", dNr, pos), np.einsum("qa,eai->eqi", dNs, pos),
-                    np.einsum("qa,eai->eqi", N, fe)], axis=-1)
-    return np.einsum("qa,eai->eqi", N, pos), jac
-
-
-def _initial_inverse_jacobians(mesh, N, dNr, dNs, tz) -> np.ndarray:
-    """(ne, nq, nt, 3, 3) inverses of dy/d(r, s, t) on the initial configuration."""
-    out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
-    for k, t in enumerate(tz):
-        jacobian = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)[1]
-        out[:, :, k] = np.linalg.inv(jacobian)
-    return out
-
-
 def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarray]:
     """The supports as :class:`~shellsim.bundles.Constraints`, and the initial fibre frames
     (n, 3) turned so that a director constraint is one rotational DOF."""
@@ -218,7 +186,7 @@ def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarra
                 prescribed["nodes"].append(node)
                 prescribed["axes"].append(AXES[bc.translation])
                 prescribed["values"].append(bc.value)
-                prescribed["curves"].append(_curve_index(deck, bc.curve))
+                prescribed["curves"].append(deck.curve_index(bc.curve))
         for node in nodes:
             constrained[node].extend(directions)
             if plane is not None:
@@ -258,20 +226,12 @@ def orthonormal(vectors: list[np.ndarray], tol: float = 1e-8) -> list[np.ndarray
     return basis
 
 
-def _curve_index(deck: Deck, name: str | None) -> int:
-    """The index of curve ``name`` in the tables; a load without one is constant (-1), or in
-    a static solve follows the ramp after the deck's curves (:func:`_curve_tables`)."""
-    if name is None:
-        return -1 if deck.solver.ramp_end is None else len(deck.curves)
-    return list(deck.curves).index(name)
-
-
-def _curve_tables(deck: Deck, names: list[str]) -> Curves:
-    """The deck's curves as padded tables; a static solve or a preload appends the linear
-    ramp from 0 at t = 0 to 1 at its end that loads without a curve follow: on beyond the
-    end of a static run, where an arc-length path may take the load time, held after a
-    preload."""
-    tables = [deck.curves[name].table() for name in names]
+def _curve_tables(deck: Deck) -> Curves:
+    """The deck's curves as padded tables, numbered as :meth:`shellsim.deck.Deck.curve_index`;
+    a static solve or a preload appends the linear ramp from 0 at t = 0 to 1 at its end
+    that loads without a curve follow: on beyond the end of a static run, where an
+    arc-length path may take the load time, held after a preload."""
+    tables = [curve.table() for curve in deck.curves.values()]
     end = deck.solver.ramp_end
     if end is not None:
         beyond = EXTRAPOLATION["linear" if deck.solver.method == "static" else "constant"]
@@ -286,95 +246,3 @@ def _curve_tables(deck: Deck, names: list[str]) -> Curves:
         length[i] = len(times)
         t[i, :len(times)], v[i, :len(times)] = times, values
     return Curves(t=t, v=v, length=length, interp=interp, extrap=extrap)
-
-
-def _edge_integral(x0: np.ndarray, edges: np.ndarray) -> np.ndarray:
-    """Consistent nodal weights int N_k ds over edge segments (m, 3) on the initial
-    geometry: (m, 3) lengths (1/6 : 4/6 : 1/6 of a straight segment)."""
-    tangent = np.einsum("pk,mki->mpi", EDGE_DN, x0[edges])
-    return np.einsum("pk,mp,p->mk", EDGE_N, np.linalg.norm(tangent, axis=-1), EDGE_W)
-
-
-def _loads(deck: Deck, mesh: Mesh, curve_names, rule: Rule, body: Body, initial: Shape) -> Loads:
-    """Every load of ``deck`` as tables (:class:`~shellsim.bundles.Loads`): dead nodal
-    vectors (edge, point, body, dead pressure, taken on the ``initial`` shape) and
-    follower pressures evaluated every step, each with its curve's index."""
-    n = mesh.n_nodes
-    dead_force, dead_force_curve, dead_moment, dead_moment_curve = [], [], [], []
-    pressure = {"elements": [], "face": [], "value": [], "curve": []}
-    edge_pressure = {"edges": [], "outward": [], "value": [], "curve": []}
-    for load in deck.load:
-        named = mesh.sets[load.set]
-        curve = _curve_index(deck, load.curve)
-        force, moment = np.zeros((n, 3)), np.zeros((n, 3))
-        if load.type == "pressure" and load.follower:
-            pressure["elements"].append(named.elements)
-            pressure["face"].append(np.full(len(named.elements), FACES[load.face]))
-            pressure["value"].append(np.full(len(named.elements), load.value))
-            pressure["curve"].append(np.full(len(named.elements), curve))
-            continue
-        if load.type == "edge_pressure":
-            edge_pressure["edges"].append(named.edges)
-            edge_pressure["outward"].append(_outward_signs(mesh, named.edges))
-            edge_pressure["value"].append(np.full(len(named.edges), load.value))
-            edge_pressure["curve"].append(np.full(len(named.edges), curve))
-            continue
-        if load.type == "pressure":  # dead: forces of the initial face, kept fixed
-            g = np.zeros((n, 3))
-            faces = PressureLoads(elements=named.elements.astype(np.int64),
-                                  face=np.full(len(named.elements), FACES[load.face]),
-                                  value=np.full(len(named.elements), load.value), curve=np.full(len(named.elements), -1))
-            pressure_forces(rule, body.conn, initial, faces, faces.value, force, g)
-        elif load.type in ("edge_force", "edge_moment"):
-            target = force if load.type == "edge_force" else moment
-            np.add.at(target, named.edges, _edge_integral(mesh.x, named.edges)[:, :, None] * np.asarray(load.value))
-        elif load.type in ("point_force", "point_moment"):
-            (force if load.type == "point_force" else moment)[named.nodes] += np.asarray(load.value)
-        else:  # body force per unit initial volume
-            volume_weights = _nodal_volumes(mesh, named.elements, rule)
-            force += volume_weights[:, None] * np.asarray(load.value)
-        if load.type in ("edge_moment", "point_moment"):
-            dead_moment.append(moment)
-            dead_moment_curve.append(curve)
-        else:
-            dead_force.append(force)
-            dead_force_curve.append(curve)
-
-    def cat(parts, dtype, shape=(0,)):
-        return np.concatenate(parts).astype(dtype) if parts else np.zeros(shape, dtype=dtype)
-
-    return Loads(
-        force=NodalLoads(vectors=np.asarray(dead_force).reshape(-1, n, 3),
-                         curve=np.asarray(dead_force_curve, dtype=np.int64)),
-        moment=NodalLoads(vectors=np.asarray(dead_moment).reshape(-1, n, 3),
-                          curve=np.asarray(dead_moment_curve, dtype=np.int64)),
-        pressure=PressureLoads(elements=cat(pressure["elements"], np.int64), face=cat(pressure["face"], np.int64),
-                               value=cat(pressure["value"], float), curve=cat(pressure["curve"], np.int64)),
-        edge_pressure=EdgePressureLoads(edges=cat(edge_pressure["edges"], np.int64, (0, 3)),
-                                        outward=cat(edge_pressure["outward"], float),
-                                        value=cat(edge_pressure["value"], float),
-                                        curve=cat(edge_pressure["curve"], np.int64)),
-    )
-
-
-def _nodal_volumes(mesh: Mesh, elements, rule: Rule) -> np.ndarray:
-    """int N_a dV over ``elements`` on the initial configuration, per node: (n,)."""
-    nq = len(rule.wq)
-    jac_inv = _initial_inverse_jacobians(mesh, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)[elements]
-    dv = np.einsum("q,t,eqt->eqt", rule.wq, rule.wt, 1.0 / np.linalg.det(jac_inv))
-    out = np.zeros(mesh.n_nodes)
-    np.add.at(out, mesh.conn[elements], np.einsum("qa,eqt->ea", rule.N[:nq], dv))
-    return out
-
-
-def _outward_signs(mesh: Mesh, edges: np.ndarray) -> np.ndarray:
-    """+1 where tangent x director points away from the element owning the edge, else -1."""
-    triples = mesh.conn[:, EDGES]  # (ne, 4, 3)
-    owner = {frozenset(t): e for e, four in enumerate(triples.tolist()) for t in four}
-    signs = np.empty(len(edges))
-    for m, edge in enumerate(edges):
-        e = owner[frozenset(edge.tolist())]
-        tangent = mesh.x[edge[2]] - mesh.x[edge[0]]
-        out = np.cross(tangent, mesh.director[edge[1]])
-        signs[m] = 1.0 if out @ (mesh.x[edge[1]] - mesh.x[mesh.conn[e, 8]]) > 0 else -1.0
-    return signs

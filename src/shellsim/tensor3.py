@@ -1,5 +1,5 @@
 """3 x 3 algebra over an element group's lanes: every array (3, 3, G) holds one matrix per
-lane, G = :data:`shellsim.element.lanes.LANES` the last axis, so each line is a packed
+lane, G = :data:`shellsim.lanes.LANES` the last axis, so each line is a packed
 loop over the lanes. The helpers are inlined into their callers (a call's argument
 passing would cost as much as the arithmetic); none allocates, and an ``out`` must be
 none of the inputs."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from .element.lanes import LANES
+from .lanes import LANES
 
 
 @njit(cache=True, error_model="numpy", inline="always")

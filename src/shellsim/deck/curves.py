@@ -12,7 +12,7 @@ import numpy as np
 from pydantic import field_validator, model_validator
 
 from ..curve_tables import EXTRAPOLATION, INTERPOLATION, curve_value
-from .types import Count, Positive, Real, Section
+from ..table_types import Count, Positive, Real, Section
 
 
 class Curve(Section):

@@ -13,7 +13,7 @@ from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import Field, model_validator
 
-from .types import Name, Positive, Section, Vec3, tag_of
+from ..table_types import Name, Positive, Section, Vec3, tag_of
 
 SetKinds = dict[str, str]
 

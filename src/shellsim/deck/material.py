@@ -14,7 +14,7 @@ from pydantic import Field
 
 from ..materials.laws import LAWS
 from ..materials.linear import LinearElastic
-from .types import tag_of
+from ..table_types import tag_of
 
 #: The models, the small-strain one first, in the order the deck reference lists them.
 MODELS = tuple(dict.fromkeys((LinearElastic, *(cls for law in LAWS for cls in law.MODELS))))

@@ -12,7 +12,7 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 from .references import did_you_mean
-from .types import tag_of
+from ..table_types import tag_of
 
 #: Keys users bring from other codes, with why shellsim does not take them.
 HINTS = {

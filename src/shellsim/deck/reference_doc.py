@@ -12,9 +12,10 @@ from pydantic_core import PydanticUndefined
 from . import schema
 from .curves import Curve
 from .geometry import BUILDERS
-from .axes import CentrelineAxes, CylindricalAxes, FixedAxes, MeshAxes
+from ..materials.axes import CentrelineAxes, CylindricalAxes, FixedAxes, MeshAxes
 from .material import MATERIALS
-from .types import tag_of
+from ..loads import TABLES as LOAD_TABLES
+from ..table_types import tag_of
 
 INTRO = """# Deck reference
 
@@ -69,8 +70,7 @@ def deck_reference() -> str:
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
     lines += ["## [[load]]", "", "Chosen by `type`; a load is `value * curve(t)`, constant without a curve "
               "(growing from 0 over a static solve).", ""]
-    for cls in (schema.Pressure, schema.EdgeForce, schema.EdgePressure, schema.EdgeMoment,
-                schema.PointForce, schema.PointMoment, schema.BodyForce):
+    for cls in LOAD_TABLES:
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")

@@ -17,9 +17,9 @@ def load_factor_columns(deck: Deck) -> dict[str, int]:
     index in the model's tables: ``load_factor_<curve>`` for every deck curve, and
     ``load_factor`` for the ramp that the loads without a curve of a static solve or a
     preload follow."""
-    columns = {f"load_factor_{name}": index for index, name in enumerate(deck.curves)}
+    columns = {f"load_factor_{name}": deck.curve_index(name) for name in deck.curves}
     if deck.solver.ramp_end is not None:
-        columns["load_factor"] = len(deck.curves)
+        columns["load_factor"] = deck.curve_index(None)
     return columns
 
 

@@ -7,14 +7,15 @@ deck (defaults filled) is what the program runs.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal, Union
+from typing import Annotated, Literal, Union
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from .curves import Curve
 from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
-from .types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
+from ..loads import TABLES as LOAD_TABLES
+from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
 
 Axis = Literal["x", "y", "z"]
 
@@ -136,85 +137,8 @@ class Prescribed(Section):
 Boundary = Annotated[Union[Clamped, Fixed, Symmetry, Prescribed], Field(discriminator="type")]
 
 
-class Pressure(Section):
-    """Pressure ``value * curve(t)`` on one face of a surface set: ``bottom`` (t = -1, the
-    side the directors point away from), ``top`` (t = +1) or the ``mid`` surface. Positive
-    pressure pushes into the shell: along the directors on the bottom face and the
-    mid-surface (it inflates a tube whose directors point outward), against them on the top
-    face. ``follower``: acts normal to the current face on its current area (thesis
-    3.12.1); otherwise a dead load along the initial normal on the initial area."""
-
-    type: Literal["pressure"]
-    set: Name = "all"
-    value: Real
-    curve: Name | None = None
-    face: Literal["bottom", "mid", "top"] = "mid"
-    follower: bool = True
-    #: The kinds of set the load acts on (:mod:`shellsim.deck.references` checks them).
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-
-
-class VectorLoad(Section):
-    """A load with global vector components, ``value * curve(t)``."""
-
-    set: Name
-    value: Vec3
-    curve: Name | None = None
-
-
-class EdgeForce(VectorLoad):
-    """Force per unit (initial) length along an edge set, global components."""
-
-    type: Literal["edge_force"]
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-
-
-class EdgePressure(Section):
-    """Pressure on the shell's edge face along an edge set (force per unit edge length is
-    ``value`` times the current thickness), normal to the edge in the shell's tangent plane;
-    positive pushes into the shell, as a pressure does. Follows the deformation."""
-
-    type: Literal["edge_pressure"]
-    set: Name
-    value: Real
-    curve: Name | None = None
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-
-
-class EdgeMoment(VectorLoad):
-    """Moment per unit (initial) length along an edge set, global components."""
-
-    type: Literal["edge_moment"]
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("edge",)
-
-
-class PointForce(VectorLoad):
-    """Force on every node of a set, global components."""
-
-    type: Literal["point_force"]
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
-
-
-class PointMoment(VectorLoad):
-    """Moment on every node of a set, global components."""
-
-    type: Literal["point_moment"]
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
-
-
-class BodyForce(VectorLoad):
-    """Force per unit (initial) volume on a surface set, global components (self-weight is
-    density times gravity)."""
-
-    type: Literal["body_force"]
-    set: Name = "all"
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-
-
-Load = Annotated[
-    Union[Pressure, EdgeForce, EdgePressure, EdgeMoment, PointForce, PointMoment, BodyForce],
-    Field(discriminator="type"),
-]
+#: A ``[[load]]`` table, chosen by ``type`` among every registered load kind's tables.
+Load = Annotated[Union[LOAD_TABLES], Field(discriminator="type")]
 
 
 class Static(Section):
@@ -306,9 +230,15 @@ OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
     "pressure_band", "green_lagrange_strain", "von_mises", "fibres",
 ]
+#: The probes' vocabulary (one place: the schema, the probes and the renders read it).
+#: Quantities by kind; those read at the integration point nearest to a probe's set.
 VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
 TENSOR_QUANTITIES = ("stress", "strain")
 SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
+POINT_QUANTITIES = ("stress", "strain", "pressure_band")
+#: Global components: a vector's column, a tensor's (row, column).
+VECTOR_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
 
 
 #: Components of a vector or tensor probe in cylindrical axes about ``axis`` (through
@@ -336,15 +266,9 @@ class Probe(Section):
     reaction's summed)."""
 
     name: Name
-    quantity: Literal[
-        "displacement", "position", "director", "rotation", "thickness", "stress", "strain",
-        "pressure_band", "reaction",
-    ]
+    quantity: Literal[VECTOR_QUANTITIES + TENSOR_QUANTITIES + SCALAR_QUANTITIES]
     set: Name
-    component: Literal[
-        "x", "y", "z", "magnitude", "xx", "yy", "zz", "xy", "yz", "zx", "scalar",
-        "radial", "circumferential", "axial", "along",
-    ] = "scalar"
+    component: Literal[(*VECTOR_COMPONENTS, "magnitude", *TENSOR_COMPONENTS, "scalar", *AXIS_COMPONENTS)] = "scalar"
     face: Literal["bottom", "mid", "top"] = "mid"
     axis: Vec3 = (0.0, 0.0, 1.0)
     origin: Vec3 = (0.0, 0.0, 0.0)
@@ -355,8 +279,8 @@ class Probe(Section):
         if self.face != "mid" and self.quantity not in ("position", "displacement"):
             raise ValueError(f"face = '{self.face}' reads a position or displacement, not {self.quantity}")
         allowed = (
-            ("x", "y", "z", "magnitude", *AXIS_COMPONENTS) if self.quantity in VECTOR_QUANTITIES
-            else ("xx", "yy", "zz", "xy", "yz", "zx", *AXIS_COMPONENTS) if self.quantity in TENSOR_QUANTITIES
+            (*VECTOR_COMPONENTS, "magnitude", *AXIS_COMPONENTS) if self.quantity in VECTOR_QUANTITIES
+            else (*TENSOR_COMPONENTS, *AXIS_COMPONENTS) if self.quantity in TENSOR_QUANTITIES
             else ("scalar",)
         )
         if self.component not in allowed:
@@ -472,6 +396,24 @@ def _one_or_many(value: object) -> object:
     return [value] if isinstance(value, dict) else value
 
 
+def _constitutive_path_problems(material, section: ShellSection) -> list[str]:
+    """What the element cannot run of this material and section: a hyperelastic law
+    runs Technique 1 in the total formulation; Techniques 2 and 3 take a linear elastic
+    material; plane strain is a small-strain section."""
+    problems = []
+    technique = section.technique
+    if material.HYPERELASTIC and technique != 1:
+        problems.append(f"section.technique: got {technique}: material.model = '{material.model}' is a strain "
+                        "energy and runs Technique 1; Techniques 2 and 3 take a linear elastic material")
+    if technique == 1 and section.formulation != "total":
+        problems.append("section.formulation: got 'incremental': Technique 1 runs in the total formulation "
+                        "(formulation = 'total')")
+    if technique is not None and section.plane_strain:
+        problems.append(f"section.plane_strain: plane strain is a small-strain section (thesis Test 7); "
+                        f"drop technique = {technique} or plane_strain")
+    return problems
+
+
 class Deck(Section):
     """A whole scene. Tables may come in any order; names are resolved after parsing."""
 
@@ -486,6 +428,14 @@ class Deck(Section):
     solver: Solver
     output: Output = Output()
     reference: Annotated[list[Reference], BeforeValidator(_one_or_many)] = []
+
+    def curve_index(self, name: str | None) -> int:
+        """Curve ``name``'s place in the model's curve tables (the deck's curves in order,
+        then the ramp of a static solve or a preload); a load without a curve is constant
+        (-1), or follows that ramp when there is one."""
+        if name is None:
+            return -1 if self.solver.ramp_end is None else len(self.curves)
+        return list(self.curves).index(name)
 
     @model_validator(mode="before")
     @classmethod
@@ -533,8 +483,7 @@ class Deck(Section):
                 f"mesh.divisions.width: must be even so the tip centre is a node, "
                 f"got {self.mesh.divisions['width']}"
             )
-        if self.material.HYPERELASTIC and self.section.technique is None:
-            problems.append("section.technique: a hyperelastic material needs a large-strain technique (1, 2 or 3)")
+        problems += _constitutive_path_problems(self.material, self.section)
         if self.output.mirror and not any(b.type == "symmetry" for b in self.boundary):
             problems.append("output.mirror: the deck has no symmetry boundary to mirror across")
         if "fibres" in self.output.fields and not self.material.ANISOTROPIC:

@@ -14,7 +14,7 @@ import numpy as np
 from numba import get_num_threads, njit, prange
 
 from .frames import director_increments, to_rotational
-from .lanes import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
+from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_response, group_scratch
 from .stress_update import INCREMENTAL, LINEAR, TOTAL
 

@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from ..tensor3 import to_global, to_lamina
-from .lanes import LANES
+from ..lanes import LANES
 
 
 @njit(cache=True, error_model="numpy", inline="always")

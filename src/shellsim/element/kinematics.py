@@ -29,7 +29,7 @@ import numpy as np
 from numba import njit
 
 from ..tensor3 import det3
-from .lanes import LANES
+from ..lanes import LANES
 
 
 

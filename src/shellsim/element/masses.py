@@ -6,7 +6,8 @@ import numpy as np
 from numba import njit
 
 from .kinematics import point_geometry
-from .lanes import LANES, gather_shape, group_count, lane_copy
+from ..lanes import LANES
+from .groups import gather_shape, group_count, lane_copy
 
 
 @njit(cache=True, error_model="numpy")

@@ -18,7 +18,7 @@ from .assumed_strain import membrane_tying_stresses, project_volumetric, shear_t
 from ..tensor3 import product
 from .kinematics import (add_forces, almansi, field_gradient, global_stress, gradient_vectors, lamina_strain,
                          point_geometry, symmetric_part)
-from .lanes import LANES
+from ..lanes import LANES
 from .stress_update import INCREMENTAL, LINEAR, TOTAL, constant_tensor, convected_layer, hyperelastic_layers
 
 

@@ -8,7 +8,8 @@ from numba import njit
 
 from ..tensor3 import product, to_global
 from .kinematics import global_stress, point_geometry
-from .lanes import LANES, gather_element_values, gather_shape, group_count, lane_copy
+from ..lanes import LANES
+from .groups import gather_element_values, gather_shape, group_count, lane_copy
 
 
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,

@@ -92,3 +92,11 @@ def gauss_rule_2d(n: int) -> tuple[np.ndarray, np.ndarray]:
     r, s = np.meshgrid(x, x, indexing="xy")
     wr, ws = np.meshgrid(w, w, indexing="xy")
     return np.column_stack([r.ravel(), s.ravel()]), (wr * ws).ravel()
+
+
+#: 3-point Gauss rule along an element edge and the 1D quadratic shape functions at its
+#: points, for (corner, mid-side, corner) node triples.
+EDGE_XI = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
+EDGE_W = np.array([5.0, 8.0, 5.0]) / 9.0
+EDGE_N = np.stack([EDGE_XI * (EDGE_XI - 1) / 2, 1 - EDGE_XI**2, EDGE_XI * (EDGE_XI + 1) / 2], axis=1)
+EDGE_DN = np.stack([EDGE_XI - 0.5, -2 * EDGE_XI, EDGE_XI + 0.5], axis=1)

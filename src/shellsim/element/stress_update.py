@@ -15,7 +15,7 @@ from numba import njit
 
 from ..materials import zero_normal_stress
 from ..tensor3 import congruence, det3, to_global, to_lamina
-from .lanes import LANES
+from ..lanes import LANES
 
 #: Modes of :func:`shellsim.element.response.group_response`: stress from the total
 #: strain, stress plus C~ times the strain increment of a field, or the material

@@ -17,7 +17,8 @@ import numpy as np
 from numba import njit, prange
 
 from .frames import cross, rotate_director
-from .lanes import LANES, gather_element_values, gather_nodal_scalars
+from ..lanes import LANES
+from .groups import gather_element_values, gather_nodal_scalars
 from .response import group_response, group_scratch
 from .stress_update import INCREMENTAL
 

@@ -31,6 +31,8 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     director = thickness = None
     surface_normals: list = []
     cell_vectors: dict[str, np.ndarray] = {}
+    point_fields: dict[str, np.ndarray] = {}
+    cell_fields: dict[str, np.ndarray] = {}
     remeshed = g.builder == "file" and g.surface
     if remeshed:
         from .session import gmsh_session
@@ -50,6 +52,7 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
         imported = read_mesh(path)
         x, conn, sets = imported.x, imported.conn, imported.sets
         director, thickness, cell_vectors = imported.director, imported.thickness, imported.cell_vectors
+        point_fields, cell_fields = imported.point_fields, imported.cell_fields
         preferred = director[conn[:, 8]] if director is not None else None
     else:
         from . import builders
@@ -80,7 +83,8 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
     # on a remeshed surface nobody knows where the nodes are: the nearest within half an element
     sets = sets | snap_points(x, deck.mesh.points, 0.5 * g.element_size if remeshed else None)
-    mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors)
+    mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors,
+                point_fields=point_fields, cell_fields=cell_fields)
     check_mesh(mesh, source, deck.section.points_through_thickness)
     return mesh
 

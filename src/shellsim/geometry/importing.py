@@ -41,7 +41,8 @@ _NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", 
 @dataclass(frozen=True)
 class ImportedMesh:
     """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and
-    thickness (n,), and per-element vectors (ne, 3) by name."""
+    thickness (n,), per-element vectors (ne, 3) and scalar fields per node (n,) and per
+    element (ne,) by name."""
 
     x: np.ndarray
     conn: np.ndarray
@@ -49,6 +50,8 @@ class ImportedMesh:
     director: np.ndarray | None
     thickness: np.ndarray | None
     cell_vectors: dict[str, np.ndarray]
+    point_fields: dict[str, np.ndarray]
+    cell_fields: dict[str, np.ndarray]
 
 
 def read_meshio(path: Path):
@@ -118,23 +121,42 @@ def read_mesh(path: Path) -> ImportedMesh:
         director = director / np.linalg.norm(director, axis=1, keepdims=True)
 
     sets = _cell_sets(path, m, blocks, offsets, index, conn)
+    point_fields = {}
     for key in m.point_data:
         if key.startswith(SET_PREFIX):
             values = np.nan_to_num(point_array(key, None))
             code = int(values.max(initial=0))
             if code in _KIND_OF_CODE:
                 sets[key[len(SET_PREFIX):]] = _node_set(_KIND_OF_CODE[code], np.flatnonzero(values), conn)
+        elif key not in ("director", "thickness") and np.asarray(m.point_data[key]).size == len(m.points):
+            point_fields[key] = _finite(path, "point", key, point_array(key, None), used + 1)
+    vectors, cell_fields = _cell_arrays(path, m, blocks)
+    return ImportedMesh(x, conn, sets, director, thickness, vectors, point_fields, cell_fields)
 
-    return ImportedMesh(x, conn, sets, director, thickness, _cell_vectors(path, m, blocks))
+
+def _finite(path: Path, where: str, name: str, values: np.ndarray, ids: np.ndarray) -> np.ndarray:
+    """``values`` of a scalar field, refused where they are not finite (naming the ids)."""
+    bad = np.flatnonzero(~np.isfinite(values))
+    if len(bad):
+        raise MeshError(f"mesh file '{path}': {where} field '{name}' is not finite at {len(bad)} "
+                        f"{'node' if where == 'point' else 'element'}(s): {id_list(ids[bad])}")
+    return values
 
 
-def _cell_vectors(path: Path, m, blocks: list[int]) -> dict[str, np.ndarray]:
-    """The cell-data arrays of three components on every quad9 block, (ne, 3) by name;
-    non-finite or zero vectors are refused, naming the elements."""
-    vectors = {}
+def _cell_arrays(path: Path, m, blocks: list[int]) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """The float cell data on every quad9 block: vectors of three components (ne, 3) by
+    name, non-finite or zero ones refused naming the elements, and scalar fields (ne,),
+    non-finite ones refused; gmsh's tags and the set markers are left to the sets."""
+    vectors, scalars = {}, {}
     for name, per_block in m.cell_data.items():
         arrays = [np.asarray(per_block[i]) for i in blocks]
-        if not all(a.ndim == 2 and a.shape[1] == 3 and a.dtype.kind == "f" for a in arrays):
+        if name.startswith((SET_PREFIX, "gmsh:")) or not all(a.dtype.kind == "f" for a in arrays):
+            continue
+        if all(a.ndim == 1 or (a.ndim == 2 and a.shape[1] == 1) for a in arrays):
+            values = np.concatenate([a.reshape(-1) for a in arrays]).astype(float)
+            scalars[name] = _finite(path, "cell", name, values, np.arange(len(values)) + 1)
+            continue
+        if not all(a.ndim == 2 and a.shape[1] == 3 for a in arrays):
             continue
         values = np.concatenate(arrays).astype(float)
         bad = np.flatnonzero(~np.all(np.isfinite(values), axis=1) | (np.linalg.norm(values, axis=1) == 0.0))
@@ -142,7 +164,7 @@ def _cell_vectors(path: Path, m, blocks: list[int]) -> dict[str, np.ndarray]:
             raise MeshError(f"mesh file '{path}': cell vectors '{name}' are not a direction (not finite, or zero) "
                             f"in {len(bad)} element(s): {id_list(bad + 1)}")
         vectors[name] = values
-    return vectors
+    return vectors, scalars
 
 
 def _cell_sets(path: Path, m, blocks: list[int], offsets: np.ndarray, index: np.ndarray,

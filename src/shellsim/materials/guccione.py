@@ -20,9 +20,9 @@ from typing import Literal
 import numpy as np
 from numba import njit
 
-from ..deck.axes import AnisotropicLaw, Axes
-from ..deck.types import Positive
-from ..element.lanes import LANES
+from .axes import AnisotropicLaw, Axes
+from ..table_types import Positive
+from ..lanes import LANES
 
 
 class Guccione(AnisotropicLaw):

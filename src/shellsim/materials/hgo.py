@@ -27,9 +27,9 @@ import numpy as np
 from numba import njit
 from pydantic import Field, model_validator
 
-from ..deck.axes import AnisotropicLaw, Axes
-from ..deck.types import NonNegative, Positive, Real
-from ..element.lanes import LANES
+from .axes import AnisotropicLaw, Axes
+from ..table_types import NonNegative, Positive, Real
+from ..lanes import LANES
 
 
 class HolzapfelGasserOgden(AnisotropicLaw):

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from ..deck.types import tag_of
+from ..table_types import tag_of
 from . import guccione, hgo, lee_sacks, mooney_rivlin, st_venant_kirchhoff
 
 #: The laws, in the order of their codes.

@@ -26,9 +26,9 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
-from ..deck.axes import AnisotropicLaw, Axes
-from ..deck.types import NonNegative, Positive, Real
-from ..element.lanes import LANES
+from .axes import AnisotropicLaw, Axes
+from ..table_types import NonNegative, Positive, Real
+from ..lanes import LANES
 
 
 class LeeSacks(AnisotropicLaw):

@@ -14,7 +14,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import field_validator
 
-from ..deck.types import Positive, Real, Section, tag_of
+from ..table_types import Positive, Real, Section, tag_of
 
 #: Transverse shear correction factor on the 13 and 23 shear moduli (Reissner-Mindlin,
 #: the value Hughes-Liu shells and LS-DYNA's SHRF default use). The thesis does not state

@@ -23,8 +23,8 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
-from ..deck.types import Positive, Section
-from ..element.lanes import LANES
+from ..table_types import Positive, Section
+from ..lanes import LANES
 
 
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..element.lanes import LANES
+from ..lanes import LANES
 from .linear import SHEAR_FACTOR, LinearElastic
 
 INCOMPRESSIBLE = False

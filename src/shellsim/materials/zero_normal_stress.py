@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..element.lanes import LANES
+from ..lanes import LANES
 from ..tensor3 import det3, to_lamina
 from .laws import energy_stress, energy_tangent
 

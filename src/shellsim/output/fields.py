@@ -22,7 +22,8 @@ import numpy as np
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import gauss_rule, shape
 from ..materials.laws import LAWS
-from ..model import Model, layer_geometry
+from ..mesh import layer_geometry
+from ..model import Model
 from ..solver.simulation import Simulation
 
 POINT_FIELDS = ("displacement", "director", "thickness")

@@ -16,11 +16,12 @@ from ..mesh import Mesh
 def write_mesh_vtu(mesh: Mesh, path: Path) -> None:
     """Write ``mesh`` to ``path`` (.vtu). Each named set becomes a point-data array
     ``set_<name>`` (1 point, 2 edge, 3 surface set; 0 outside) and, for surface sets, a
-    cell-data array of the same name; per-element vectors are cell data by their names."""
+    cell-data array of the same name; per-element vectors and scalar fields are point and
+    cell data by their names."""
     import meshio
 
-    point_data = {"director": mesh.director, "thickness": mesh.thickness}
-    cell_data = {name: [vectors] for name, vectors in mesh.cell_vectors.items()}
+    point_data = {"director": mesh.director, "thickness": mesh.thickness} | mesh.point_fields
+    cell_data = {name: [values] for name, values in (mesh.cell_vectors | mesh.cell_fields).items()}
     for name, named in mesh.sets.items():
         member = np.zeros(mesh.n_nodes, dtype=np.uint8)
         member[named.nodes] = KIND_CODE[named.kind]

@@ -37,9 +37,8 @@ def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
     """(value of the first time-curved load at ``times``, axis label), or None."""
     for load in deck.load:
         if getattr(load, "curve", None) and np.ndim(load.value) == 0:
-            kind = "stress" if load.type in ("pressure", "edge_pressure") else "load"
             label = f"{load.type.replace('_', ' ')} on '{load.set}'"
-            return load.value * deck.curves[load.curve](times), labelled(label, kind, deck.meta.units)
+            return load.value * deck.curves[load.curve](times), labelled(label, load.QUANTITY, deck.meta.units)
     return None
 
 

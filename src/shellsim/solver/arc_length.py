@@ -40,21 +40,18 @@ AIM, GROWTH, LONGEST = 5, (0.5, 2.0), 4.0
 class LoadRate:
     """q = d f_ext / dt over the free unknowns at the state's shape, by central
     differences of the external forces in load time (scratch arrays of their own, so the
-    last evaluation's forces and pressures stay as they are)."""
+    last evaluation's forces stay as they are)."""
 
     def __init__(self, newton: NewtonSolver):
         sim = newton.run.sim
         self.sim, self.unknowns = sim, newton.eq.unknowns
         n = sim.model.n_nodes
-        space = sim.workspace
         self.step = RATE_STEP * newton.run.deck.solver.end_time
         self._f, self._fr, self._g = np.empty((n, 3)), np.empty((n, 2)), np.empty((n, 3))
-        self._pressure, self._edges = np.empty_like(space.scale_pressure), np.empty_like(space.scale_edges)
         self._external = TypedCall(external_forces)
 
     def _forces(self, t: float) -> np.ndarray:
-        self._external(float(t), self.sim.model, self.sim.state.fields.shape, self._f, self._fr, self._g,
-                       self._pressure, self._edges)
+        self._external(float(t), self.sim.model, self.sim.state.fields.shape, self._f, self._fr, self._g)
         return self.unknowns.gather(self.unknowns.to_local(self._f, self._fr))[:self.unknowns.n_free]
 
     def __call__(self, t: float) -> np.ndarray:

@@ -4,8 +4,8 @@ tangent stiffness assembled sparse, and the state moved by a correction.
 The residual is what the time loop computes, f_ext(t) - f_int, for every formulation,
 material and load (fibre-length update included), taken over the unknowns of
 :mod:`.unknowns`. The tangent is the sum of the elements' own (:mod:`shellsim.element.tangent`),
-less the derivative of the follower pressures and of the dead moments, which turn with
-the shell. The incremental formulations measure their strain from the last converged
+less the derivative of the loads that turn with the shell (each load kind's own,
+:class:`shellsim.loads.LoadTangents`). The incremental formulations measure their strain from the last converged
 state, so every evaluation starts from its stresses and fibre lengths.
 """
 
@@ -14,13 +14,12 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..element.frames import rotate_directors, to_rotational
+from ..element.frames import rotate_directors
 from ..element.stress_update import INCREMENTAL, TOTAL
 from ..element.tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
 from ..curve_tables import factor
-from ..loads.edge_pressure import edge_pressure_tangents
-from ..loads.pressure import pressure_tangents
+from ..loads import LoadTangents
 from . import explicit
 from .simulation import Simulation
 from .unknowns import SLOTS, unknowns
@@ -56,16 +55,9 @@ class Equilibrium:
         size = np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1))
         self.step_u = STEP_SHARE * size
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
-        self.pressure_k = np.zeros((len(model.loads.pressure.elements), ELEMENT_DOFS, ELEMENT_DOFS))
-        self._edge_slots = _edge_slots(model)
-        self.edge_k = np.zeros((len(model.loads.edge_pressure.edges), 9, 15))
-        self.moment_nodes = np.flatnonzero(np.abs(model.loads.moment.vectors).sum(axis=(0, 2)) > 0)
-        # each moment node's first slot e * 9 + a: its diagonal block in element e takes the moment's stiffness
-        self._moment_slots = model.body.slots[model.body.node_slots[self.moment_nodes]]
         self._t = 0.0
         self._tangents = TypedCall(element_tangents)
-        self._pressure_tangents = TypedCall(pressure_tangents)
-        self._edge_tangents = TypedCall(edge_pressure_tangents)
+        self._load_tangents = LoadTangents(model)
         self._forces = TypedCall(explicit.forces)
         self._pattern()
 
@@ -151,17 +143,7 @@ class Equilibrium:
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
         self._tangents(np.int64(self.mode), model.rule, model.body, model.material, shape, space.dx, space.dd,
                        c["stress"], self.step_u, STEP_ROTATION, k)
-        pressure = model.loads.pressure
-        if len(pressure.elements):
-            self._pressure_tangents(model.rule, model.conn, s.fields.shape, pressure, space.scale_pressure,
-                                    self.step_u, STEP_ROTATION, self.pressure_k)
-            np.subtract.at(k, pressure.elements, self.pressure_k)
-        if len(self.edge_k):
-            self._edge_tangents(s.fields.shape, model.loads.edge_pressure, space.scale_edges, self.step_u,
-                                STEP_ROTATION, self.edge_k)
-            np.subtract.at(k, self._edge_slots, self.edge_k)
-        if len(self.moment_nodes):
-            self._add_moment_stiffness(k)
+        self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
         if self._turned:
             blocks = self._element_blocks
             k = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k.reshape(len(k), 9, SLOTS, 9, SLOTS), blocks,
@@ -169,38 +151,3 @@ class Equilibrium:
         indices, indptr, nnz = self._csc
         data = np.bincount(self._slot, weights=k.ravel()[self._entries], minlength=nnz)
         return sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
-
-    def _add_moment_stiffness(self, k: np.ndarray) -> None:
-        """Less the derivative of the dead moments' rotational forces with respect to the
-        node's rotations, central differences, into the node's diagonal block in its first
-        element."""
-        model, s = self.sim.model, self.sim.state
-        nodes = self.moment_nodes
-        moments = np.zeros((len(nodes), 3))
-        for vectors, curve in zip(model.loads.moment.vectors, model.loads.moment.curve):
-            moments += factor(model.curves, curve, self._t) * vectors[nodes]
-        block = np.zeros((len(nodes), 2, 2))
-        fr = np.empty((len(nodes), 2))
-        for j in range(2):
-            for sign in (1.0, -1.0):
-                d, e1 = s.d[nodes], s.e1[nodes]
-                turn = np.zeros((len(nodes), 2))
-                turn[:, j] = sign * STEP_ROTATION
-                rotate_directors(d, e1, np.arange(len(nodes)), turn)
-                to_rotational(np.cross(moments, d), d, e1, fr)  # the moment's director force M x d
-                block[:, :, j] -= sign * fr / (2 * STEP_ROTATION)
-        for slot, b in zip(self._moment_slots, block):
-            e, a = divmod(int(slot), 9)
-            k[e, 5 * a + 3:5 * a + 5, 5 * a + 3:5 * a + 5] += b
-
-
-def _edge_slots(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Where each pressure-loaded edge's tangent (E, 9, 15) goes in the elements' (ne, 45,
-    45): the first element holding its mid-side node (which holds the whole edge), and the
-    rows of the three nodes' forces and the columns of their DOFs in it, as an index of k."""
-    edges = model.loads.edge_pressure.edges
-    element = model.body.slots[model.body.node_slots[edges[:, 1]]] // 9
-    local = np.argmax(model.conn[element][:, :, None] == edges[:, None, :], axis=1)  # (E, 3)
-    rows = (5 * local[:, :, None] + np.arange(3)).reshape(len(edges), 9)
-    cols = (5 * local[:, :, None] + np.arange(5)).reshape(len(edges), 15)
-    return element[:, None, None], rows[:, :, None], cols[:, None, :]

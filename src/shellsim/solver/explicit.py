@@ -33,14 +33,11 @@ INTERNAL, KINETIC, EXTERNAL, DAMPED = range(4)
 class Workspace(NamedTuple):
     """Scratch of the time loop, allocated once per simulation (n nodes): dx, dd (n, 3)
     the last step's mid-surface and director increments; g (n, 3) director-conjugate
-    external forces; scale_pressure (P,), scale_edges (E,) the current load values;
-    parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`)."""
+    external forces; parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`)."""
 
     dx: np.ndarray
     dd: np.ndarray
     g: np.ndarray
-    scale_pressure: np.ndarray
-    scale_edges: np.ndarray
     parts: Assembly
 
 
@@ -48,8 +45,6 @@ def workspace(model) -> Workspace:
     """A :class:`Workspace` for ``model`` (:class:`shellsim.bundles.Model`)."""
     n = model.x0.shape[0]
     return Workspace(dx=np.zeros((n, 3)), dd=np.zeros((n, 3)), g=np.zeros((n, 3)),
-                     scale_pressure=np.zeros(len(model.loads.pressure.elements)),
-                     scale_edges=np.zeros(len(model.loads.edge_pressure.edges)),
                      parts=assembly(n, len(model.body.conn)))
 
 
@@ -60,8 +55,7 @@ def forces(t, model, fields, space):
     forces of the incremental formulation take the last step's increments from ``space``."""
     internal_forces(model.rule, model.body, model.material, fields.shape, space.dx, space.dd, fields.stress,
                     fields.f_int, fields.fr_int, space.parts)
-    external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g, space.scale_pressure,
-                    space.scale_edges)
+    external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g)
 
 
 @njit(cache=True)

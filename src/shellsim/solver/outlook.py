@@ -17,7 +17,7 @@ from numba import get_num_threads
 
 from ..deck import Deck
 from ..deck.schema import Solver
-from ..element.lanes import group_count
+from ..element.groups import group_count
 from ..element.tangent import BATCHES
 from ..errors import SceneTooLarge
 from ..model import Model

@@ -23,7 +23,7 @@ from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
 from ..mesh import Mesh
 from ..model import Model
-from ..output.probes import Probe, probe_value, resolve_probes
+from .probes import Probe, probe_value, resolve_probes
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step

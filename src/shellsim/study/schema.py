@@ -33,7 +33,7 @@ from typing import Annotated, Literal
 
 from pydantic import Field, ValidationError, model_validator
 
-from ..deck.types import Section, repeated
+from ..table_types import Section, repeated
 from ..errors import DeckError
 
 Text = Annotated[str, Field(strict=True, min_length=1)]

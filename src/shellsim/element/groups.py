@@ -1,23 +1,14 @@
-"""Element groups: the kernels evaluate LANES elements together, the element index the
-innermost axis of every work array, so each arithmetic line runs over a contiguous
-vector of elements and compiles to packed SIMD (the grouping of production explicit
-codes, e.g. OpenRadioss' MVSIZ). A work array of shape (..., G) holds one value per lane
-(G = LANES); group g holds elements g * LANES ... g * LANES + LANES - 1. A group at the
-end of the mesh fills its spare lanes with the last element again: computed like the
-others, never written back.
-
-LANES = 16 was measured on the point geometry alone (50 points of an element, an AVX-512
-core, helpers inlined): 8.5 microseconds per element one element at a time, 5.1 with 8
-lanes, 1.2 with 16, 1.1 with 32; 16 keeps a group's work arrays (about 0.4 MB) within the
-core's L2 cache. Meshes of fewer than 16 elements pay for the spare lanes.
+"""Element groups: group g holds elements g * LANES ... g * LANES + LANES - 1
+(:data:`shellsim.lanes.LANES`), gathered into lanes and put back. A group at the end of
+the mesh fills its spare lanes with the last element again: computed like the others,
+never written back.
 """
 
 from __future__ import annotations
 
 from numba import njit
 
-#: Elements per group (a compile-time constant of every kernel).
-LANES = 16
+from ..lanes import LANES
 
 
 @njit(cache=True)
@@ -105,3 +96,13 @@ def lane_store(values, lane, lane_values):
     lanes = lane_values.reshape((values.size, LANES))
     for j in range(values.size):
         lanes[j, lane] = flat[j]
+
+
+@njit(cache=True)
+def gather_nodes(shape, nodes, xe, de, he):
+    """The mid-surface points, directors and fibre lengths of an edge's or a face's nodes
+    (k,) into xe, de (k, 3) and he (k,)."""
+    for a in range(nodes.shape[0]):
+        xe[a] = shape.x[nodes[a]]
+        de[a] = shape.d[nodes[a]]
+        he[a] = shape.h[nodes[a]]

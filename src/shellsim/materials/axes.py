@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from ..errors import MeshError
-from .types import Name, Section, Vec3
+from ..table_types import Name, Section, Vec3
 
 #: An angle of material axis 1 about the lamina normal (degrees).
 Angle = Annotated[float, Field(strict=True, ge=-180.0, le=180.0, allow_inf_nan=False)]

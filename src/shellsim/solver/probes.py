@@ -7,18 +7,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..deck.schema import AXIS_COMPONENTS
+from ..deck.schema import AXIS_COMPONENTS, POINT_QUANTITIES, TENSOR_COMPONENTS, VECTOR_COMPONENTS
 from ..deck.schema import Probe as ProbeTable
 from ..element.kinematics import fibre_point
 from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
 from ..errors import MeshError
 from ..mesh import Mesh
-from ..model import FACES, Model
+from ..mesh import FACES
+from ..model import Model
 
-#: Quantities read at the integration point nearest to the probe's set.
-POINT_QUANTITIES = ("stress", "strain", "pressure_band")
-#: Tensor components of a probe as (row, column) of the global tensor.
-TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
 
 
 @dataclass
@@ -110,7 +107,7 @@ def probe_value(sim, probe: Probe) -> float:
         if probe.directions is not None:
             return float(np.einsum("ki,ki->", vectors, probe.directions))
         total = vectors.sum(axis=0)
-        return float(np.linalg.norm(total) if probe.component == "magnitude" else total["xyz".index(probe.component)])
+        return float(np.linalg.norm(total) if probe.component == "magnitude" else total[VECTOR_COMPONENTS[probe.component]])
     if probe.quantity == "director":
         vectors = s.d[nodes]
     else:  # a position or displacement on the probe's face
@@ -124,4 +121,4 @@ def probe_value(sim, probe: Probe) -> float:
     vector = vectors.mean(axis=0)
     if probe.component == "magnitude":
         return float(np.linalg.norm(vector))
-    return float(vector["xyz".index(probe.component)])
+    return float(vector[VECTOR_COMPONENTS[probe.component]])

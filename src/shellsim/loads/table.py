@@ -1,0 +1,27 @@
+"""The base of every ``[[load]]`` table: what the registry, the plan and the plots read
+from a load kind's deck table besides its own keys."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from ..table_types import Section
+
+
+class LoadTable(Section):
+    """A load ``value * curve(t)`` on a named set (``set`` and ``curve`` are each
+    table's own keys, with their defaults).
+
+    SET_KINDS: the kinds of set it acts on (:mod:`shellsim.deck.references` checks them);
+    FEATURES: the plan's features (:mod:`shellsim.plan`) this table may use, the first
+    unless :attr:`feature` says otherwise; QUANTITY: what ``value`` is, for plot axes:
+    "stress" (force per area) or "load"."""
+
+    SET_KINDS: ClassVar[tuple[str, ...]]
+    FEATURES: ClassVar[tuple[str, ...]]
+    QUANTITY: ClassVar[str] = "load"
+
+    @property
+    def feature(self) -> str:
+        """The plan's feature this load uses."""
+        return self.FEATURES[0]

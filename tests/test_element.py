@@ -76,7 +76,7 @@ def internal(model, x, d, e1, h=None, step=None, stress=None):
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=x, d=d, e1=e1, h=model.h0.copy() if h is None else h)
     material = model.material._replace(incremental=step is not None)
-    internal_forces(model.rule, model.body, material, shape, x * 0 if step is None else step, x * 0, stress, f, fr,
+    internal_forces(model._replace(material=material), shape, x * 0 if step is None else step, x * 0, stress, f, fr,
                     assembly(n, model.n_elements))
     return f, fr, stress
 
@@ -89,7 +89,7 @@ def stiffness(model, vu, vr, x=None, stress=None):
     if stress is None:
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
-    stiffness_product(model.rule, model.body, model.material, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
+    stiffness_product(model, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
     return f, fr
 
 
@@ -213,8 +213,8 @@ def test_point_tensors_are_the_plane_stress_law_and_the_exact_strain_in_global_a
     law = model.material.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     sigma = np.array([[law[0], law[2], 0.0], [law[2], law[1], 0.0], [0.0, 0.0, 0.0]])
     out = [np.empty((model.n_elements, 9, len(model.rule.tz), 3, 3)) for _ in range(3)]
-    point_tensors(x, d, model.h0, model.conn, model.rule.N[:9], model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz,
-                  model.body.jac0_inv, stress, *out)
+    point_tensors((x, d, model.h0), model.conn, (model.rule.N[:9], model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz),
+                  model.body.jac0_inv, stress, tuple(out))
     lamina, cauchy, green = out
     np.testing.assert_allclose(cauchy, np.broadcast_to(R @ sigma @ R.T, cauchy.shape), atol=1e-6 * np.abs(law).max())
     F = np.eye(3) + STRAIN
@@ -228,9 +228,9 @@ def test_rigid_rotation_gives_zero_green_lagrange_strain_everywhere(curved):
     model = curved
     R = rotation(np.array([0.3, -0.5, 0.8]), 2.4)
     out = [np.empty((model.n_elements, 9, len(model.rule.tz), 3, 3)) for _ in range(3)]
-    point_tensors(model.x0 @ R.T + [1.0, -2.0, 3.0], model.d0 @ R.T, model.h0, model.conn, model.rule.N[:9],
-                  model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz, model.body.jac0_inv,
-                  np.zeros((model.n_elements, 9, len(model.rule.tz), 5)), *out)
+    point_tensors((model.x0 @ R.T + [1.0, -2.0, 3.0], model.d0 @ R.T, model.h0), model.conn,
+                  (model.rule.N[:9], model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz), model.body.jac0_inv,
+                  np.zeros((model.n_elements, 9, len(model.rule.tz), 5)), tuple(out))
     assert np.abs(out[2]).max() < 1e-12
 
 

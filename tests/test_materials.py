@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from shellsim.bundles import Material
+from shellsim.element.steps import HYPERELASTIC
 from shellsim.lanes import LANES
 from shellsim.materials import zero_normal_stress as zns
 from shellsim.materials.laws import LAWS, energy, law_of
@@ -27,9 +28,9 @@ PARAMETERS = {
 def material(model: str) -> Material:
     """The kernels' bundle for the law serving ``model`` with :data:`PARAMETERS`."""
     code, law = law_of(model)
-    return Material(law=code, params=PARAMETERS[model], incompressible=law.INCOMPRESSIBLE,
-                    C=np.zeros((5, 5)), axes0=np.zeros((1, 1, 1, 3, 3)), technique=1, normal_ratio=0.0,
-                    incremental=False, thickness_update=False)
+    return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=False, law=code,
+                    params=PARAMETERS[model], incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)),
+                    C=np.zeros((5, 5)), normal_ratio=0.0)
 
 
 def random_strains(rng, size):
@@ -186,12 +187,8 @@ FIBRE_LAWS = {
 def _fibre_law(case: str, beta_deg: float):
     """(kernels' Material, closed-form Cauchy stress) of a :data:`FIBRE_LAWS` case."""
     model, params, cauchy = FIBRE_LAWS[case]
-    code, law = law_of(model)
     beta = np.radians(beta_deg)
-    mat = Material(law=code, params=np.array(params(np.cos(beta), np.sin(beta)), dtype=float), incompressible=True,
-                   C=np.zeros((5, 5)), axes0=np.zeros((1, 1, 1, 3, 3)), technique=1, normal_ratio=0.0,
-                   incremental=False, thickness_update=False)
-    return mat, cauchy
+    return material(model)._replace(params=np.array(params(np.cos(beta), np.sin(beta)), dtype=float)), cauchy
 
 
 def _stretched(mat: Material, l1: float, l2: float):

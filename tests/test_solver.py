@@ -94,7 +94,7 @@ def test_a_degenerate_operator_is_a_message_not_an_arpack_error():
 
     sim = prepared(parse_deck(PLATE.read_text())).sim
     sim.update_masses()
-    zero = sim.compiled._replace(stiffness=lambda *args: [a.fill(0.0) for a in args[7:9]])
+    zero = sim.compiled._replace(stiffness=lambda *args: [a.fill(0.0) for a in args[5:7]])
     sim.compiled = zero
     with pytest.raises(NumericalError, match=r"could not be estimated at t = 0: .*check the magnitudes of material.E"):
         timestep.largest_eigenvalue(sim)

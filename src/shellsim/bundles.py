@@ -56,28 +56,31 @@ class Body(NamedTuple):
 
 
 class Material(NamedTuple):
-    """The constitutive path.
+    """The constitutive path, decided once when the model is built.
 
-    law: the code of a hyperelastic law (:mod:`shellsim.materials.laws`; Technique 1
-    only); params (P,): its parameters; incompressible: whether it keeps J = 1; C (5, 5):
-    reduced lamina matrix of the constant tensor [stress] (the other techniques); axes0
-    (ne, nq, nt, 3, 3) initial material frames of a hyperelastic law (rows a1, a2, a3;
-    (1, ...) unused otherwise); technique: 0 small strain, 1, 2 or 3 (thesis 3.10);
-    normal_ratio: nu / (1 - nu), the normal strain increment per in-plane one of
-    Techniques 2 and 3; incremental: stress accumulated from strain increments (thesis
-    Eq 3.2) instead of computed from the total strain; thickness_update: the fibre
-    lengths follow the normal stretch (thesis 3.11).
+    path: SMALL_STRAIN, HYPERELASTIC (Technique 1) or CONVECTED (Techniques 2 and 3) of
+    :mod:`shellsim.element.steps` (thesis 3.10); incremental: stress accumulated from
+    strain increments (thesis Eq 3.2) instead of computed from the total strain (small
+    strain by choice, convected always); push_forward: Technique 2's stretch of the
+    accumulated stresses; thickness_update: the fibre lengths follow the normal stretch
+    (thesis 3.11). law: the code of a hyperelastic law (:mod:`shellsim.materials.laws`);
+    params (P,): its parameters; incompressible: whether it keeps J = 1; axes0
+    (ne, nq, nt, 3, 3) its initial material frames (rows a1, a2, a3; (1, ...) unused
+    otherwise). C (5, 5): reduced lamina matrix of the constant tensor [stress] (the other
+    paths); normal_ratio: nu / (1 - nu), the normal strain increment per in-plane one of
+    the convected path.
     """
 
+    path: int
+    incremental: bool
+    push_forward: bool
+    thickness_update: bool
     law: int
     params: np.ndarray
     incompressible: bool
-    C: np.ndarray
     axes0: np.ndarray
-    technique: int
+    C: np.ndarray
     normal_ratio: float
-    incremental: bool
-    thickness_update: bool
 
 
 class Curves(NamedTuple):

@@ -16,6 +16,7 @@ from .bundles import Body, Constraints, Curves, Material, Model, Prescribed, Rul
 from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
 from .element.frames import initial_fibre_frame
+from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .loads import LoadScene, build_loads
 from .materials.laws import law_of
@@ -105,21 +106,23 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
     material, section = deck.material, deck.section
     nq = len(rule.wq)
     no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
-    constant = dict(law=0, params=np.zeros(1), incompressible=False, axes0=no_axes, normal_ratio=0.0)
+    constant = dict(push_forward=False, law=0, params=np.zeros(1), incompressible=False, axes0=no_axes,
+                    normal_ratio=0.0)
     if section.technique is None:
-        return Material(C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), technique=0,
-                        incremental=section.formulation == "incremental", thickness_update=False, **constant)
+        return Material(path=SMALL_STRAIN, incremental=section.formulation == "incremental", thickness_update=False,
+                        C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), **constant)
     if section.technique in (2, 3):
         # constant tensor, stresses accumulated in the lamina frame from each step's
         # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
-        return Material(C=reduced_lamina_matrix(material.E, material.nu), technique=section.technique,
-                        incremental=True, thickness_update=deck.thickness_update,
-                        **(constant | {"normal_ratio": material.nu / (1.0 - material.nu)}))
+        return Material(path=CONVECTED, incremental=True, thickness_update=deck.thickness_update,
+                        C=reduced_lamina_matrix(material.E, material.nu),
+                        **(constant | {"push_forward": section.technique == 2,
+                                       "normal_ratio": material.nu / (1.0 - material.nu)}))
     code, law = law_of(material.model)
     axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
-    return Material(law=code, params=law.parameters(material), incompressible=law.INCOMPRESSIBLE, C=np.zeros((5, 5)),
-                    axes0=axes0, technique=1, normal_ratio=0.0, incremental=False,
-                    thickness_update=deck.thickness_update)
+    return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=deck.thickness_update,
+                    law=code, params=law.parameters(material), incompressible=law.INCOMPRESSIBLE, axes0=axes0,
+                    C=np.zeros((5, 5)), normal_ratio=0.0)
 
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:

@@ -15,8 +15,8 @@ from numba import get_num_threads, njit, prange
 
 from .frames import director_increments, to_rotational
 from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
-from .response import group_response, group_scratch
-from .stress_update import INCREMENTAL, LINEAR, TOTAL
+from .response import group_arrays, group_response
+from .steps import steps_of
 
 
 class Assembly(NamedTuple):
@@ -44,17 +44,16 @@ def assembly(n_nodes: int, n_elements: int) -> Assembly:
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stress, f, fr, parts):
+def _all_elements(steps, rule, body, material, shape, ux, ud, stress, f, fr, parts):  # noqa: PLR0913 (prange-bound: flat bundles)
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
-    mode: of :mod:`shellsim.element.stress_update`; ux, ud (n, 3) the field's
-    translations and director increments (INCREMENTAL, LINEAR); stress (ne, nq, nt, 5)
-    written (read too when INCREMENTAL; untouched when LINEAR); state_stress: the current
-    stress (LINEAR).
+    steps: :class:`shellsim.element.steps.Steps`; ux, ud (n, 3) the field's translations
+    and director increments (not total); stress (ne, nq, nt, 5) written (read too when
+    incremental), or, for the product, the state's stress (read only).
 
-    With Techniques 2 and 3 (INCREMENTAL mode), the fibre lengths are scaled each step by
+    With Techniques 2 and 3 (convected), the fibre lengths are scaled each step by
     1 + the step's normal strain increment (thesis Eq 3.33); with a hyperelastic law in
-    TOTAL mode the initial ones by the normal stretch, h = h0 lambda_3 (thesis 3.11), one
+    the response the initial ones by the normal stretch, h = h0 lambda_3 (thesis 3.11), one
     step behind the kinematics as in the thesis. Either factor is the element's volume
     mean, and a node takes the volume-weighted mean of its elements': averaged from the
     integration points with weights N_a dv, or N_a^2 dv, the nodal lengths of a refined
@@ -65,63 +64,59 @@ def _all_elements(mode, rule, body, material, shape, ux, ud, stress, state_stres
     into lambda_3 (a loop no energy stands behind, which broke Test 10 down). The updated
     h moves the faces (pressure, probes), masses and volume.
     """
-    hyper = material.technique == 1
     groups = group_count(body.conn.shape[0])
     chunks = parts.chunks
-    incremental_update = material.technique >= 2 and mode == INCREMENTAL
-    update = material.thickness_update and ((hyper and mode == TOTAL) or incremental_update)
     # the chunks' bodies run in a function of their own: a nested bundle cannot cross into
     # a prange body, and code written inline there was compiled wrongly
     for c in prange(chunks):
-        _group_run(c * groups // chunks, (c + 1) * groups // chunks, mode, rule, body, material, shape, ux, ud, stress,
-                   state_stress, parts, update)
+        _group_run(c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
+                   parts)
     _gather_at_nodes(body, parts, f)
     to_rotational(parts.g, shape.d, shape.e1, fr)
-    if update:
-        _update_fibre_lengths(body, parts, shape.h, incremental_update)
+    if steps.update_lengths:
+        _update_fibre_lengths(body, parts, shape.h, steps.convected)
 
 
 @njit(cache=True, error_model="numpy")
-def _group_run(start, stop, mode, rule, body, material, shape, ux, ud, stress, state_stress, parts, update):
+def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (prange-bound)
     """The responses of groups start..stop-1 into their elements' slots of ``parts`` and
-    ``stress``; arguments as :func:`_all_elements`, ``update``: whether the fibre lengths
-    follow (element volumes and mean stretches are then kept)."""
+    ``stress``; arguments as :func:`_all_elements`. Element volumes and mean stretches are
+    kept when the fibre lengths follow."""
     conn = body.conn
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
-    work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
-    members = work.members
-    hyper = material.technique == 1
-    lengths = body.h0 if hyper else shape.h
-    for group in range(start, stop):
-        count = gather_shape(group, conn, shape.x, shape.d, lengths, members, work.xe, work.de, work.he)
-        gather_element_values(body.jac0_inv, members, work.jac0)
-        if hyper:
-            gather_element_values(material.axes0, members, work.axes0)
-        if mode != TOTAL:
-            gather_nodal_vectors(conn, members, ux, work.ue)
-            gather_nodal_vectors(conn, members, ud, work.ve)
-        if mode == INCREMENTAL:
-            gather_element_values(stress, members, work.stress)
-        if mode == LINEAR:
-            gather_element_values(state_stress, members, work.state_stress)
-        group_response(mode, rule, material, work, count)
-        if mode != LINEAR:  # the K v product's stresses are the field's, of no use after
-            scatter_element_values(work.stress, members, count, stress)
+    group, points, scratch = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
+    members = group.members
+    lengths = body.h0 if steps.hyperelastic else shape.h
+    for g in range(start, stop):
+        count = gather_shape(g, conn, (shape.x, shape.d, lengths), members, (group.xe, group.de, group.he))
+        gather_element_values(body.jac0_inv, members, group.jac0)
+        if steps.hyperelastic:
+            gather_element_values(material.axes0, members, group.axes0)
+        if not steps.total:
+            gather_nodal_vectors(conn, members, ux, group.ue)
+            gather_nodal_vectors(conn, members, ud, group.ve)
+        if steps.incremental:
+            gather_element_values(stress, members, group.stress)
+        if steps.product:
+            gather_element_values(stress, members, group.state_stress)
+        group_response(steps, rule, material, group, points, scratch, count)
+        if not steps.product:  # the K v product's stresses are the field's, of no use after
+            scatter_element_values(group.stress, members, count, stress)
         for lane in range(count):
             e = members[lane]
             for a in range(9):
                 for i in range(3):
-                    parts.fe[e, a, i] = work.fe[a, i, lane]
-                    parts.ge[e, a, i] = work.ge[a, i, lane]
-            if update:
+                    parts.fe[e, a, i] = group.fe[a, i, lane]
+                    parts.ge[e, a, i] = group.ge[a, i, lane]
+            if steps.update_lengths:
                 volume = 0.0
                 mean = 0.0
                 for p in range(nq):
                     dv = 0.0
                     for k in range(nt):
-                        dv += work.DV[p, k, lane]
+                        dv += points.DV[p, k, lane]
                     volume += dv
-                    mean += dv * work.stretch[p, lane]
+                    mean += dv * group.stretch[p, lane]
                 parts.volume[e] = volume
                 parts.stretch[e] = mean
 
@@ -157,13 +152,13 @@ def _update_fibre_lengths(body, parts, h, incremental):
 
 
 @njit(cache=True, error_model="numpy")
-def internal_forces(rule, body, material, shape, dx, dd, stress, f, fr, parts):
+def internal_forces(model, shape, dx, dd, stress, f, fr, parts):
     """Internal forces of all elements at the current configuration.
 
     Parameters
     ----------
-    rule, body, material : :class:`shellsim.bundles.Rule`, :class:`~shellsim.bundles.Body`,
-        :class:`~shellsim.bundles.Material`. In the total formulation the stress follows
+    model : :class:`shellsim.bundles.Model`: its rule, body and material (whose path,
+        :class:`~shellsim.bundles.Material`, says how). In the total formulation the stress follows
         from the total deformation (Almansi strain, thesis Eq 3.1 and 3.22); in the
         incremental one (``material.incremental``) the stress in the lamina frame gains
         C~ times the strain increment of the last step (Eq 3.2).
@@ -174,12 +169,15 @@ def internal_forces(rule, body, material, shape, dx, dd, stress, f, fr, parts):
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     parts : :class:`Assembly` of the mesh (scratch).
     """
-    _all_elements(INCREMENTAL if material.incremental else TOTAL, rule, body, material, shape, dx, dd, stress, stress,
-                  f, fr, parts)
+    # a run-time boolean: a constant would type as a literal and compile the whole element
+    # path once more for the product (half of a cold start's compiling)
+    material = model.material
+    _all_elements(steps_of(material, np.bool_(False)), model.rule, model.body, material, shape, dx, dd, stress, f, fr,
+                  parts)
 
 
 @njit(cache=True, error_model="numpy")
-def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts):
+def stiffness_product(model, shape, stress, vu, vr, f, fr, parts):
     """Tangent stiffness times a DOF vector, K v, without forming K: the material part
     K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
     Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
@@ -192,6 +190,6 @@ def stiffness_product(rule, body, material, shape, stress, vu, vr, f, fr, parts)
     """
     vd = np.empty((shape.x.shape[0], 3))
     director_increments(vr, shape.d, shape.e1, vd)
-    # the mode as a run-time integer: passed as the constant, it would type as a literal and
-    # compile the whole element path a second time (half of a cold start's compiling)
-    _all_elements(np.int64(LINEAR), rule, body, material, shape, vu, vd, stress, stress, f, fr, parts)
+    material = model.material
+    _all_elements(steps_of(material, np.bool_(True)), model.rule, model.body, material, shape, vu, vd, stress, f, fr,
+                  parts)

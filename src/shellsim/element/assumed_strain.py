@@ -1,7 +1,7 @@
 """Assumed membrane and transverse shear strains of an element group, and their adjoints
 (the effective stresses they put at the tying points); the in-plane volumetric projection
-of plane strain. Arrays carry the group's lanes last (G); ``work`` is the group's
-:class:`shellsim.element.response.GroupScratch`.
+of plane strain. Arrays carry the group's lanes last (G); ``points`` and ``scratch`` are
+the group's :class:`shellsim.element.response.Points` and ``Scratch``.
 
 Assumed membrane strain against membrane locking (a curved quadratic element cannot bend
 without stretching by O(theta^2), which full integration samples): the covariant
@@ -57,11 +57,12 @@ def _solve2(a00, a01, a10, a11, b0, b1, out0, out1):
 
 
 @njit(cache=True, error_model="numpy")
-def tie_membrane(rule, work, nq, nt):
-    """Replace the membrane part of the lamina strains work.EPS at the Gauss points by
+def tie_membrane(rule, points, scratch, nq, nt):
+    """Replace the membrane part of the lamina strains points.EPS at the Gauss points by
     its tied interpolation (the through-thickness means weighted by rule.share)."""
     tie, tie_points, share = rule.tie, rule.tie_points, rule.share
-    EPS, Q, G, cbar, plane, glob, local, delta = work.EPS, work.Q, work.G, work.cbar, work.plane, work.glob, work.local, work.delta
+    EPS, Q, G, cbar = points.EPS, points.Q, points.G, points.cbar
+    plane, glob, local, delta = scratch.plane, scratch.glob, scratch.local, scratch.delta
     # covariant membrane strains c_ab = g_a . eps . g_b (frame-free) and their
     # through-thickness means cbar at every point
     cbar[:] = 0.0
@@ -90,7 +91,7 @@ def tie_membrane(rule, work, nq, nt):
                     for lane in range(LANES):
                         delta[c, lane] += tie[c, p, m] * cbar[tie_points[c, m], c, lane]
         for k in range(nt):
-            _contravariant_tensor(delta, work.jinv_all[p, k], glob)
+            _contravariant_tensor(delta, points.jinv_all[p, k], glob)
             to_lamina(Q[p, k], glob, local)
             for lane in range(LANES):
                 EPS[p, k, 0, lane] += local[0, 0, lane]
@@ -99,13 +100,13 @@ def tie_membrane(rule, work, nq, nt):
 
 
 @njit(cache=True, error_model="numpy")
-def tie_shear(rule, work, nq, nt):
-    """Replace the transverse shears of work.EPS at the Gauss points by their tied
+def tie_shear(rule, points, scratch, nq, nt):
+    """Replace the transverse shears of points.EPS at the Gauss points by their tied
     interpolation: the covariant shears gamma_a = g_a . gamma (gamma = (2e13, 2e23) in
     the lamina plane), gamma_r on the rr points and gamma_s on the ss points (MITC9).
-    Keeps the tangents' lamina components work.A (npts, nt, 2, 2, G) for the adjoint."""
+    Keeps the tangents' lamina components points.A (npts, nt, 2, 2, G) for the adjoint."""
     tie, tie_points = rule.tie, rule.tie_points
-    EPS, Q, G, A, cov_shear, delta = work.EPS, work.Q, work.G, work.A, work.cov_shear, work.delta
+    EPS, Q, G, A, cov_shear, delta = points.EPS, points.Q, points.G, points.A, points.cov_shear, scratch.delta
     for x in range(EPS.shape[0]):
         for k in range(nt):
             q, g, lam = Q[x, k], G[x, k], A[x, k]
@@ -130,14 +131,14 @@ def tie_shear(rule, work, nq, nt):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_tying_stresses(rule, work, nq, nt):
-    """The adjoint of :func:`tie_membrane`: the volume-weighted in-plane stresses work.SW
+def membrane_tying_stresses(rule, points, scratch, nq, nt):
+    """The adjoint of :func:`tie_membrane`: the volume-weighted in-plane stresses points.SW
     contracted with the contravariant basis, Bab(p) = sum_k dv g^a . sigma_m . g^b (twice
     for rs), act back through -cbar(p) at the Gauss points and through the tying at the
-    tying points; writes their weights work.T (npts, 3, G), each to act as the global
+    tying points; writes their weights points.T (npts, 3, G), each to act as the global
     stress (w_k / W) sum_ab T_ab sym(g_a (x) g_b)."""
     tie, tie_points = rule.tie, rule.tie_points
-    SW, Q, Bab, T, plane, glob = work.SW, work.Q, work.Bab, work.T, work.plane, work.glob
+    SW, Q, Bab, T, plane, glob = points.SW, points.Q, points.Bab, points.T, scratch.plane, scratch.glob
     Bab[:] = 0.0
     plane[:] = 0.0
     for p in range(nq):
@@ -147,7 +148,7 @@ def membrane_tying_stresses(rule, work, nq, nt):
                 plane[1, 1, lane] = SW[p, k, 1, lane]
                 plane[0, 1, lane] = plane[1, 0, lane] = SW[p, k, 2, lane]
             to_global(Q[p, k], plane, glob)
-            jinv = work.jinv_all[p, k]
+            jinv = points.jinv_all[p, k]
             for c, (a, b, factor) in enumerate(((0, 0, 1.0), (1, 1, 1.0), (0, 1, 2.0))):
                 for lane in range(LANES):
                     acc = 0.0
@@ -167,13 +168,13 @@ def membrane_tying_stresses(rule, work, nq, nt):
 
 
 @njit(cache=True, error_model="numpy")
-def shear_tying_stresses(rule, work, stress, nq, nt):
+def shear_tying_stresses(rule, points, stress, scratch, nq, nt):
     """The adjoint of :func:`tie_shear`: the shear stresses (in ``stress`` (nq, nt, 5, G))
     work through the tied covariant shears only; tau . A_p^-1 g* at the Gauss points puts
-    A_m^T (sum_p tie(p, m) A_p^-T tau_p dv_p) at each tying point m. Writes work.TS
+    A_m^T (sum_p tie(p, m) A_p^-T tau_p dv_p) at each tying point m. Writes points.TS
     (npts, nt, 2, G), the covariant factors of those effective shear stresses."""
     tie, tie_points = rule.tie, rule.tie_points
-    A, DV, TS, delta, b0, b1 = work.A, work.DV, work.TS, work.delta, work.cov[0], work.cov[1]
+    A, DV, TS, delta, b0, b1 = points.A, points.DV, points.TS, scratch.delta, scratch.cov[0], scratch.cov[1]
     TS[:] = 0.0
     for p in range(nq):
         for k in range(nt):
@@ -190,7 +191,7 @@ def shear_tying_stresses(rule, work, stress, nq, nt):
 
 
 @njit(cache=True, error_model="numpy")
-def project_volumetric(V, DV, basis, nq, nt, adjoint, count, Mb, rhs):
+def project_volumetric(V, DV, basis, adjoint, count, scratch):
     """In-plane volumetric strain projected, layer by layer, on the fields of ``basis``
     (nq, nb): with (1, r, s) the 9-node quadrilateral becomes Q9/P3, free of volumetric
     locking in plane strain.
@@ -201,9 +202,10 @@ def project_volumetric(V, DV, basis, nq, nt, adjoint, count, Mb, rhs):
     Adjoint (adjoint=True): V = SW (npts, nt, 3, G), the volume-weighted in-plane
     stresses; with S = (SW_11 + SW_22) / 2 their virtual work through e_v* adds
     DV(q) phi(q)^T Mb^-1 sum_p phi(p) S(p) - S(q) to both normal stresses at each point
-    q. DV (npts, nt, G) point volumes; the first ``count`` lanes; Mb (nb, nb) and rhs
-    (nb,) scratch."""
-    nb = basis.shape[1]
+    q. DV (npts, nt, G) point volumes; basis (nq, nb); the first ``count`` lanes;
+    scratch.Mb (nb, nb) and scratch.rhs (nb,) as scratch."""
+    nq, nb, nt = basis.shape[0], basis.shape[1], V.shape[1]
+    Mb, rhs = scratch.Mb, scratch.rhs
     for k in range(nt):
         for lane in range(count):
             Mb[:] = 0.0

@@ -28,10 +28,12 @@ def group_members(group, ne, members):
 
 
 @njit(cache=True, error_model="numpy")
-def gather_shape(group, conn, x, d, h, members, xe, de, he):
-    """A group's members (:func:`group_members`) and their positions and directors
-    xe, de (9, 3, G) and fibre lengths he (9, G) from the nodal x, d (n, 3) and h (n,);
-    returns how many lanes hold elements of their own."""
+def gather_shape(group, conn, nodes, members, element):
+    """A group's members (:func:`group_members`) and element = (xe, de, he): their
+    positions and directors (9, 3, G) and fibre lengths (9, G) from nodes = (x, d, h),
+    the nodal (n, 3), (n, 3) and (n,); returns how many lanes hold elements of their own."""
+    x, d, h = nodes
+    xe, de, he = element
     count = group_members(group, conn.shape[0], members)
     gather_nodal_vectors(conn, members, x, xe)
     gather_nodal_vectors(conn, members, d, de)

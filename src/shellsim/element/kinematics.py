@@ -70,12 +70,16 @@ def lamina_frame(jac, q):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def point_geometry(xe, de, he, N, dNr, dNs, t, jac, jinv, q, det):
+def point_geometry(element, functions, t, out):
     """Current Jacobian, its determinant and inverse, and the lamina frame at one point.
 
-    xe, de (9, 3, G) positions and directors, he (9, G) fibre lengths; N, dNr, dNs (9,)
-    at the point; t the thickness coordinate. Writes jac, jinv, q (3, 3, G), det (G,).
+    element = (xe, de, he): positions and directors (9, 3, G), fibre lengths (9, G);
+    functions = (N, dNr, dNs) (9,) at the point; t the thickness coordinate. Writes
+    out = (jac, jinv, q) (3, 3, G) and det (G,).
     """
+    xe, de, he = element
+    N, dNr, dNs = functions
+    jac, jinv, q, det = out
     for i in range(3):
         for m in range(3):
             for lane in range(LANES):

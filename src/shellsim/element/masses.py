@@ -34,13 +34,13 @@ def lumped_masses(rule, body, shape, density, hughes, mt, mr):
     raw, rot, volume = np.empty((9, LANES)), np.empty((9, LANES)), np.empty(LANES)
     raw1, rot1, he1 = np.empty(9), np.empty(9), np.empty(9)
     for group in range(group_count(conn.shape[0])):
-        count = gather_shape(group, conn, shape.x, shape.d, shape.h, members, xe, de, he)
+        count = gather_shape(group, conn, (shape.x, shape.d, shape.h), members, (xe, de, he))
         raw[:] = 0.0
         rot[:] = 0.0
         volume[:] = 0.0
         for p in range(wq.shape[0]):
             for k in range(tz.shape[0]):
-                point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, det)
+                point_geometry((xe, de, he), (N[p], dNr[p], dNs[p]), tz[k], (jac, jinv, q, det))
                 for lane in range(LANES):
                     dv = det[lane] * wq[p] * wt[k]
                     volume[lane] += dv

@@ -33,19 +33,22 @@ def pressure_band(sigma: np.ndarray) -> np.ndarray:
 
 
 @njit(cache=True, error_model="numpy")
-def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauchy, green):
+def point_tensors(nodes, conn, points, jac0_inv, stress, out):
     """Tensors at every integration point (element e, in-plane point q, layer k).
 
-    Inputs: x, d (n, 3), h (n,): current mid-surface, directors, fibre lengths; conn
-    (ne, 9); N, dNr, dNs (nq, 9): shape functions at the in-plane points; tz (nt,): layer
-    coordinates; jac0_inv (ne, >= nq, nt, 3, 3): inverse initial Jacobians; stress
-    (ne, nq, nt, 5): lamina stresses (s11, s22, s12, s13, s23).
+    Inputs: nodes = (x, d, h), the current mid-surface and directors (n, 3) and fibre
+    lengths (n,); conn (ne, 9); points = (N, dNr, dNs, tz): shape functions at the
+    in-plane points (nq, 9) and the layer coordinates (nt,); jac0_inv (ne, >= nq, nt, 3,
+    3): inverse initial Jacobians; stress (ne, nq, nt, 5): lamina stresses (s11, s22, s12,
+    s13, s23).
 
-    Writes, each (ne, nq, nt, 3, 3): ``lamina``, the stress in the lamina frame (s33 = 0);
+    Writes out = (lamina, cauchy, green), each (ne, nq, nt, 3, 3): ``lamina``, the stress in the lamina frame (s33 = 0);
     ``cauchy``, the same turned to global axes (q^T lamina q, q the current lamina frame);
     ``green``, the Green-Lagrange strain (F^T F - I) / 2 in global axes with
     F = dx/d(r, s, t) (dX/d(r, s, t))^-1.
     """
+    N, dNr, dNs, tz = points
+    lamina, cauchy, green = out
     members = np.empty(LANES, dtype=np.int64)
     xe, de, he = np.empty((9, 3, LANES)), np.empty((9, 3, LANES)), np.empty((9, LANES))
     jac0 = np.empty(jac0_inv.shape[1:] + (LANES,))
@@ -55,11 +58,11 @@ def point_tensors(x, d, h, conn, N, dNr, dNs, tz, jac0_inv, stress, lamina, cauc
     for i in range(3):
         same[i, i, :] = 1.0  # the lamina frame is its own; also the identity
     for group in range(group_count(conn.shape[0])):
-        count = gather_shape(group, conn, x, d, h, members, xe, de, he)
+        count = gather_shape(group, conn, nodes, members, (xe, de, he))
         gather_element_values(jac0_inv, members, jac0)
         for p in range(N.shape[0]):
             for k in range(tz.shape[0]):
-                point_geometry(xe, de, he, N[p], dNr[p], dNs[p], tz[k], jac, jinv, q, det)
+                point_geometry((xe, de, he), (N[p], dNr[p], dNs[p]), tz[k], (jac, jinv, q, det))
                 for i in range(5):
                     for lane in range(LANES):
                         s5[i, lane] = stress[members[lane], p, k, i]

@@ -4,8 +4,8 @@ hyperelastic law under zero normal stress (Technique 1,
 :mod:`shellsim.materials.zero_normal_stress`), and the turning and stretching of
 Techniques 2 and 3's accumulated stresses.
 
-Arrays with a trailing G carry the group's lanes; ``work`` is the group's
-:class:`shellsim.element.response.GroupScratch`.
+Arrays with a trailing G carry the group's lanes; ``group``, ``points`` and ``scratch``
+are the group's arrays (:mod:`shellsim.element.response`).
 """
 
 from __future__ import annotations
@@ -16,12 +16,6 @@ from numba import njit
 from ..materials import zero_normal_stress
 from ..tensor3 import congruence, det3, to_global, to_lamina
 from ..lanes import LANES
-
-#: Modes of :func:`shellsim.element.response.group_response`: stress from the total
-#: strain, stress plus C~ times the strain increment of a field, or the material
-#: stiffness product (strain of a field, tangent times it).
-TOTAL, INCREMENTAL, LINEAR = 0, 1, 2
-
 
 @njit(cache=True, error_model="numpy")
 def constant_tensor(C, eps, stress, incremental):
@@ -38,14 +32,15 @@ def constant_tensor(C, eps, stress, incremental):
 
 
 @njit(cache=True, error_model="numpy")
-def hyperelastic_layers(mode, material, work, stress, p, share):
+def hyperelastic_layers(product, material, group, points, scratch, p, share):
     """Technique 1 at Gauss point p (thesis 3.10.1), every layer and lane: lamina Cauchy
-    stresses into ``stress`` (nq, nt, 5, G) (TOTAL), or the tangent times the field's
-    strain (LINEAR); the point volumes work.DV become true volumes. share (nt,): layer
-    weights over their sum. TOTAL also writes work.stretch[p] (G,), the normal stretch of
-    the fibre's mean strain (thesis Eq 3.31; the layers' bending parts cancel).
+    stresses into group.stress (nq, nt, 5, G), or, for the stiffness ``product``, the
+    tangent times the field's strain; the point volumes points.DV become true volumes.
+    share (nt,): layer weights over their sum. The response also writes
+    group.stretch[p] (G,), the normal stretch of the fibre's mean strain (thesis Eq 3.31;
+    the layers' bending parts cancel).
 
-    Fl = q F R0^T maps the initial material frame R0 (work.axes0; rows: axes 1, 2, 3 =
+    Fl = q F R0^T maps the initial material frame R0 (group.axes0; rows: axes 1, 2, 3 =
     normal) to the current lamina frame q; its Green-Lagrange strain 1/2 (Fl^T Fl - I)
     gets the assumed-strain correction pulled back exactly, Fl^T (eps - eps0) Fl (eps:
     lamina strains after the tying, eps0: before; the tangent leaves it out). E33 then
@@ -56,17 +51,18 @@ def hyperelastic_layers(mode, material, work, stress, p, share):
     virtual work then takes (Fl S~ Fl^T, the Kirchhoff stress, does not depend on Fl's
     normal column while S~_33 = 0, up to transverse shear). The tangent is pushed
     forward the same way (Eq 3.26), for the field's lamina strain pulled back."""
-    Fl, D, E, S, Cinv, dE, dS, tmp = work.M[0], work.M[1], work.M[2], work.M[3], work.M[4], work.M[5], work.M[6], work.M[7]
-    law_work, det, pressure, volume, Emean = work.M[8:], work.det, work.pressure, work.volume, work.Emean
+    M = scratch.M
+    Fl, D, E, S, Cinv, dE, dS, tmp = M[0], M[1], M[2], M[3], M[4], M[5], M[6], M[7]
+    law_work, det, pressure, volume, Emean = M[8:], scratch.det, scratch.pressure, scratch.volume, scratch.Emean
     Emean[:] = 0.0
     for k in range(share.shape[0]):
-        congruence(work.Q[p, k], work.FP[p, k], work.axes0[p, k], Fl)
+        congruence(points.Q[p, k], points.FP[p, k], group.axes0[p, k], Fl)
         det3(Fl, det)
         # 1/2 (Fl^T Fl - I) + Fl^T (eps - eps0) Fl = Fl^T (eps - eps0 + I/2) Fl - I/2
         D[:] = 0.0
-        if mode == TOTAL:
-            _add_strain_tensor(work.EPS[p, k], 1.0, D)
-            _add_strain_tensor(work.EPS0[p, k], -1.0, D)
+        if not product:
+            _add_strain_tensor(points.EPS[p, k], 1.0, D)
+            _add_strain_tensor(points.EPS0[p, k], -1.0, D)
         for i in range(3):
             for lane in range(LANES):
                 D[i, i, lane] += 0.5
@@ -74,38 +70,39 @@ def hyperelastic_layers(mode, material, work, stress, p, share):
         for i in range(3):
             for lane in range(LANES):
                 E[i, i, lane] -= 0.5
-        if mode == TOTAL:
+        if not product:
             for i in range(3):
                 for j in range(3):
                     for lane in range(LANES):
                         Emean[i, j, lane] += share[k] * E[i, j, lane]
         zero_normal_stress.stress(material, E, S, Cinv, pressure, volume, law_work)
-        if mode != TOTAL:  # the tangent at the current state times the field's strain
+        if product:  # the tangent at the current state times the field's strain
             D[:] = 0.0
-            _add_strain_tensor(work.EPS[p, k], 1.0, D)
+            _add_strain_tensor(points.EPS[p, k], 1.0, D)
             to_global(Fl, D, dE)
             zero_normal_stress.tangent(material, E, Cinv, pressure, dE, dS, law_work)
             S = dS
-        _push_forward(Fl, S, volume, tmp, stress[p, k])
+        _push_forward(Fl, S, volume, tmp, group.stress[p, k])
         for lane in range(LANES):
-            work.DV[p, k, lane] *= volume[lane] / det[lane]
-    if mode == TOTAL:
-        zero_normal_stress.normal_strain(material, Emean, work.stretch[p], law_work)
+            points.DV[p, k, lane] *= volume[lane] / det[lane]
+    if not product:
+        zero_normal_stress.normal_strain(material, Emean, group.stretch[p], law_work)
 
 
 @njit(cache=True, error_model="numpy")
-def convected_layer(material, work, stress, p, k, share, stretch):
+def convected_layer(material, group, points, scratch, p, k, share):
     """Techniques 2 and 3 at Gauss point p, layer k, every lane, after the stress
     increment: the normal strain increment from zero normal stress (added, times the
-    layer's share, to stretch (nq, G)), Technique 2's push-forward by the step's stretch,
-    and the turn by the material's spin relative to the lamina frame."""
-    normal, s5 = work.normal, stress[p, k]
+    layer's share, to group.stretch (nq, G)), Technique 2's push-forward by the step's
+    stretch (material.push_forward), and the turn by the material's spin relative to the
+    lamina frame."""
+    normal, s5, M = scratch.normal, group.stress[p, k], scratch.M
     for lane in range(LANES):
-        normal[lane] = -material.normal_ratio * (work.EPS[p, k, 0, lane] + work.EPS[p, k, 1, lane])
-        stretch[p, lane] += share * normal[lane]
-    if material.technique == 2:
-        _convect(s5, work.EPS[p, k], normal, work.M[0], work.M[1], work.M[2], work.det)
-    _follow_material_spin(s5, work.LP[p, k], work.Q[p, k], work.G[p, k], work.M[0])
+        normal[lane] = -material.normal_ratio * (points.EPS[p, k, 0, lane] + points.EPS[p, k, 1, lane])
+        group.stretch[p, lane] += share * normal[lane]
+    if material.push_forward:
+        _convect(s5, points.EPS[p, k], normal, M[0], M[1], M[2], scratch.det)
+    _follow_material_spin(s5, points.LP[p, k], points.Q[p, k], points.G[p, k], M[0])
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -19,8 +19,8 @@ from numba import njit, prange
 from .frames import cross, rotate_director
 from ..lanes import LANES
 from .groups import gather_element_values, gather_nodal_scalars
-from .response import group_response, group_scratch
-from .stress_update import INCREMENTAL
+from .response import group_arrays, group_response
+from .steps import steps_of
 
 #: DOFs of an element: 9 nodes x (3 translations, 2 rotations).
 ELEMENT_DOFS = 45
@@ -31,10 +31,13 @@ BATCHES = -(-_MOVES // LANES)
 
 
 @njit(cache=True, error_model="numpy")
-def moved_node(x, d, e1, move, step_u, step_r, xm, dm, e1m):
-    """The position, director and fibre axis xm, dm, e1m (3,) of a node (x, d, e1 (3,))
-    moved by DOF ``move // 2`` of its five (forward when even): +-step_u along an axis or
-    +-step_r about a fibre axis. Returns the signed step."""
+def moved_node(x, d, e1, move, differences, moved):
+    """moved = (xm, dm, e1m) (3,): the position, director and fibre axis of a node (x, d,
+    e1 (3,)) moved by DOF ``move // 2`` of its five (forward when even): +-step_u along an
+    axis or +-step_r about a fibre axis, differences = (step_u, step_r). Returns the
+    signed step."""
+    step_u, step_r = differences
+    xm, dm, e1m = moved
     slot, sign = move // 2, 1.0 if move % 2 == 0 else -1.0
     xm[:] = x
     dm[:] = d
@@ -47,84 +50,89 @@ def moved_node(x, d, e1, move, step_u, step_r, xm, dm, e1m):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def element_tangents(mode, rule, body, material, shape, dx, dd, stress, step_u, step_r, k):
+def element_tangents(rule, body, material, shape, converged, differences, k):
     """k (ne, 45, 45): each element's tangent stiffness, the derivative of its internal nodal
     forces with respect to its DOFs (both in the module's order).
 
-    mode: TOTAL or INCREMENTAL (:mod:`shellsim.element.stress_update`); shape: the
-    current :class:`~shellsim.bundles.Shape`; dx, dd (n, 3) the increments of position and
-    director since the last converged state and stress (ne, nq, nt, 5) the stress there
-    (INCREMENTAL only); step_u [length], step_r [rad]: the difference steps. The fibre
-    lengths are held (their update follows the deformation one evaluation behind).
+    shape: the current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
+    increments (n, 3) of position and director since the last converged state and the
+    stress (ne, nq, nt, 5) there (read by an incremental material only); differences:
+    (step_u [length], step_r [rad]), the difference steps. The fibre lengths are held
+    (their update follows the deformation one evaluation behind).
     """
     ne = body.conn.shape[0]
+    dx, dd, stress = converged
+    step_u, step_r = differences
+    path = steps_of(material, np.bool_(False))
     for e in prange(ne):
-        _element_tangent(e, mode, rule, body, material, shape, dx, dd, stress, step_u, step_r, k[e])
+        _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, k[e])
 
 
 @njit(cache=True, error_model="numpy")
-def _element_tangent(e, mode, rule, body, material, shape, dx, dd, stress, step_u, step_r, ke):
-    """ke (45, 45) of element e; arguments as :func:`element_tangents`. Every lane holds
-    the element as it is; each batch moves one node of each lane and puts it back after."""
+def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, ke):  # noqa: PLR0913 (prange-bound)
+    """ke (45, 45) of element e; arguments as :func:`element_tangents`, ``path`` its
+    :class:`~shellsim.element.steps.Steps`. Every lane holds the element as it is; each
+    batch moves one node of each lane and puts it back after."""
     conn = body.conn
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
-    work = group_scratch(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
-    hyper = material.technique == 1
-    members = work.members
+    group, points, scratch = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
+    members = group.members
     members[:] = e
-    gather_nodal_scalars(conn, members, body.h0 if hyper else shape.h, work.he)
-    gather_element_values(body.jac0_inv, members, work.jac0)
-    if hyper:
-        gather_element_values(material.axes0, members, work.axes0)
-    if mode == INCREMENTAL:
-        gather_element_values(stress, members, work.stress)
-        base_stress = work.stress.copy()
+    gather_nodal_scalars(conn, members, body.h0 if path.hyperelastic else shape.h, group.he)
+    gather_element_values(body.jac0_inv, members, group.jac0)
+    if path.hyperelastic:
+        gather_element_values(material.axes0, members, group.axes0)
+    if path.incremental:
+        gather_element_values(stress, members, group.stress)
+        base_stress = group.stress.copy()
     frames = np.empty((9, 2, 3, LANES))  # each lane's fibre axes e1, e2 at its nodes
     for a in range(9):
         node = conn[e, a]
-        _place_node(work, frames, a, -1, shape.x[node], shape.d[node], shape.e1[node], dx[node], dd[node])
+        _place_node(group, frames, a, -1, (shape.x[node], shape.d[node], shape.e1[node]), (dx[node], dd[node]))
     xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
-    steps = np.zeros(LANES)
+    moves = np.zeros(LANES)
     ke[:] = 0.0
     for batch in range(BATCHES):
         for lane in range(LANES):
             move = min(batch * LANES + lane, _MOVES - 1)
             node = conn[e, move // 10]
-            steps[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r, xm, dm,
-                                     e1m)
-            _place_node(work, frames, move // 10, lane, xm, dm, e1m, dx[node] + xm - shape.x[node],
-                        dd[node] + dm - shape.d[node])
-        if mode == INCREMENTAL:
-            work.stress[:] = base_stress
-        group_response(mode, rule, material, work, LANES)
+            moves[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, (step_u, step_r),
+                                     (xm, dm, e1m))
+            _place_node(group, frames, move // 10, lane, (xm, dm, e1m),
+                        (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
+        if path.incremental:
+            group.stress[:] = base_stress
+        group_response(path, rule, material, group, points, scratch, LANES)
         for lane in range(LANES):
             move = min(batch * LANES + lane, _MOVES - 1)
             if batch * LANES + lane < _MOVES:
                 column = move // 2
-                weight = 1.0 / (2.0 * steps[lane])  # + f / 2h forward, - f / 2h back (steps[lane] = -h)
+                weight = 1.0 / (2.0 * moves[lane])  # + f / 2h forward, - f / 2h back (moves[lane] = -h)
                 for a in range(9):
                     for i in range(3):
-                        ke[5 * a + i, column] += weight * work.fe[a, i, lane]
+                        ke[5 * a + i, column] += weight * group.fe[a, i, lane]
                     for j in range(2):  # in the moved frames
-                        ke[5 * a + 3 + j, column] -= weight * (frames[a, j, 0, lane] * work.ge[a, 0, lane]
-                                                               + frames[a, j, 1, lane] * work.ge[a, 1, lane]
-                                                               + frames[a, j, 2, lane] * work.ge[a, 2, lane])
+                        ke[5 * a + 3 + j, column] -= weight * (frames[a, j, 0, lane] * group.ge[a, 0, lane]
+                                                               + frames[a, j, 1, lane] * group.ge[a, 1, lane]
+                                                               + frames[a, j, 2, lane] * group.ge[a, 2, lane])
             node = conn[e, move // 10]
-            _place_node(work, frames, move // 10, lane, shape.x[node], shape.d[node], shape.e1[node], dx[node],
-                        dd[node])
+            _place_node(group, frames, move // 10, lane, (shape.x[node], shape.d[node], shape.e1[node]),
+                        (dx[node], dd[node]))
 
 
 @njit(cache=True, inline="always")
-def _place_node(work, frames, a, lane, x, d, e1, u, v):
-    """Node a of lane ``lane`` (every lane when -1) at position x, director d, fibre axis
-    e1 (3,), with increments u, v (3,) from the converged state."""
+def _place_node(group, frames, a, lane, node, increments):
+    """Node a of lane ``lane`` (every lane when -1) at node = (x, d, e1) (3,): position,
+    director and fibre axis, with increments = (u, v) (3,) from the converged state."""
+    x, d, e1 = node
+    u, v = increments
     first, stop = (0, LANES) if lane < 0 else (lane, lane + 1)
     e2 = cross(d, e1)
     for k in range(first, stop):
         for i in range(3):
-            work.xe[a, i, k] = x[i]
-            work.de[a, i, k] = d[i]
-            work.ue[a, i, k] = u[i]
-            work.ve[a, i, k] = v[i]
+            group.xe[a, i, k] = x[i]
+            group.de[a, i, k] = d[i]
+            group.ue[a, i, k] = u[i]
+            group.ve[a, i, k] = v[i]
             frames[a, 0, i, k] = e1[i]
             frames[a, 1, i, k] = e2[i]

@@ -132,8 +132,8 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
         ke[:] = 0.0
         for move in range(30):
             moved, node = move // 10, nodes[move // 10]
-            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r, xe[moved],
-                              de[moved], e1e[moved])
+            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, (step_u, step_r),
+                              (xe[moved], de[moved], e1e[moved]))
             fe[:] = 0.0
             edge_forces(xe, de, he, loads.outward[m], pressure, fe)
             weight = 1.0 / (2.0 * step)

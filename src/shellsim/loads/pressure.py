@@ -170,8 +170,8 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
         ke[:] = 0.0
         for move in range(2 * ELEMENT_DOFS):
             moved, node = move // 10, nodes[move // 10]
-            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, step_u, step_r, xe[moved],
-                              de[moved], e1e[moved])
+            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, (step_u, step_r),
+                              (xe[moved], de[moved], e1e[moved]))
             fe[:] = 0.0
             ge[:] = 0.0
             face_forces(rule, xe, de, he, loads.face[m], pressure, fe, ge)

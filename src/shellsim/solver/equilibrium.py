@@ -15,7 +15,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..element.frames import rotate_directors
-from ..element.stress_update import INCREMENTAL, TOTAL
 from ..element.tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
 from ..curve_tables import factor
@@ -49,7 +48,7 @@ class Equilibrium:
         self.sim = sim
         model = sim.model
         self.unknowns = unknowns(model)
-        self.mode = INCREMENTAL if model.material.incremental else TOTAL
+        self.incremental = model.material.incremental
         self.converged = Converged(sim)
         conn = model.conn
         size = np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1))
@@ -91,7 +90,7 @@ class Equilibrium:
         incremental formulations from the converged state."""
         self._t = t
         s, space = self.sim.state, self.sim.workspace
-        if self.mode == INCREMENTAL:
+        if self.incremental:
             c = self.converged.arrays
             np.subtract(s.x, c["x"], out=space.dx)
             np.subtract(s.d, c["d"], out=space.dd)
@@ -138,11 +137,11 @@ class Equilibrium:
         model, s, space = self.sim.model, self.sim.state, self.sim.workspace
         c = self.converged.arrays
         shape = s.fields.shape
-        if self.mode == INCREMENTAL:  # the increments are measured with the converged lengths
+        if self.incremental:  # the increments are measured with the converged lengths
             shape = shape._replace(h=c["h"])
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
-        self._tangents(np.int64(self.mode), model.rule, model.body, model.material, shape, space.dx, space.dd,
-                       c["stress"], self.step_u, STEP_ROTATION, k)
+        self._tangents(model.rule, model.body, model.material, shape, (space.dx, space.dd, c["stress"]),
+                       (self.step_u, STEP_ROTATION), k)
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
         if self._turned:
             blocks = self._element_blocks

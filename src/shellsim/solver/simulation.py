@@ -90,7 +90,7 @@ class Simulation:
         N, dNr, dNs = rule.N[:nq][points], rule.dNr[:nq][points], rule.dNs[:nq][points]
         out = [np.empty((len(conn), len(N), len(rule.tz), 3, 3)) for _ in range(3)]
         jac0_inv = np.ascontiguousarray(m.body.jac0_inv[elements][:, :nq][:, points])
-        point_tensors(s.x, s.d, s.h, conn, N, dNr, dNs, rule.tz, jac0_inv, s.stress[elements][:, points], *out)
+        point_tensors((s.x, s.d, s.h), conn, (N, dNr, dNs, rule.tz), jac0_inv, s.stress[elements][:, points], tuple(out))
         return tuple(out)
 
     def critical_time_step(self, on_product: Callable[[int], None] | None = None) -> float:

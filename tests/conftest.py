@@ -8,6 +8,11 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+# The console the command line prints to is 80 columns wide in every test, whatever the
+# terminal the suite runs in: messages and tables wrap the same way, so no outcome depends
+# on it (subprocesses inherit it too).
+os.environ["COLUMNS"] = "80"
+os.environ.pop("LINES", None)
 if os.environ.get("PYTEST_XDIST_WORKER"):
     # one test process per core already: a worker's kernels run on one thread each
     os.environ.setdefault("NUMBA_NUM_THREADS", "1")

@@ -178,6 +178,47 @@ def test_a_period_longer_than_the_table_leaves_a_gap_it_interpolates(tmp_path):
     np.testing.assert_allclose(curve(np.array([0.5, 0.75, 1.0, 1.5, 2.0])), [1.0, 0.5, 0.0, 1.0, 1.0])
 
 
+@pytest.mark.parametrize(("text", "rows"), [
+    ("time;pressure\n0,0;80,0\n0,1;118,5\n", [(0.0, 80.0), (0.1, 118.5)]),  # decimal commas, ';' between
+    ("time\tpressure\n0,0\t80\n0,25\t95,5\n", [(0.0, 80.0), (0.25, 95.5)]),  # decimal commas, tabs between
+    ("\ufefftime,pressure\n0,80\n0.5,95\n", [(0.0, 80.0), (0.5, 95.0)]),  # Excel's CSV UTF-8: a byte-order mark
+    ("\ufeff0,80\n0.5,95\n", [(0.0, 80.0), (0.5, 95.0)]),  # a mark before the first data row keeps it
+    ("0 80\n0.5   95  # end\n", [(0.0, 80.0), (0.5, 95.0)]),  # spaces, a trailing comment
+])
+def test_a_waveform_file_is_read_in_the_ways_spreadsheets_write_it(tmp_path, text, rows):
+    from shellsim.deck.curves import read_table
+
+    path = tmp_path / "beat.csv"
+    path.write_bytes(text.encode("utf-8"))
+    t, value = read_table(path)
+    assert list(zip(t, value)) == rows
+
+
+@pytest.mark.parametrize(("csv", "expected"), [
+    ("t,p\nnan,80\n1,90\n", ["beat.csv' line 2", "expected finite numbers", "nan,80"]),
+    ("t,p\n0,80\n1,inf\n", ["beat.csv' line 3", "expected finite numbers"]),
+    ("0,5 80,0\n", ["holds no (time, value) rows"]),  # spaces between, decimal commas: not guessed
+])
+def test_a_waveform_row_that_is_not_two_finite_numbers_is_named(tmp_path, csv, expected):
+    path = _waveform_deck(tmp_path, 'file = "beat.csv"\n')
+    (tmp_path / "beat.csv").write_text(csv)
+    with pytest.raises(DeckError) as caught:
+        load_deck(path)
+    for part in expected:
+        assert part in str(caught.value), str(caught.value)
+
+
+def test_a_waveform_that_is_a_pipe_or_too_long_is_refused_without_reading_it(tmp_path):
+    import os
+
+    path = _waveform_deck(tmp_path, 'file = "pipe.csv"\n')
+    os.mkfifo(tmp_path / "pipe.csv")  # reading it would wait for a writer forever
+    with pytest.raises(DeckError, match="pipe.csv' is not a regular file"):
+        load_deck(path)
+    with pytest.raises(DeckError, match="'repeat' = 100000000 cycles of 2 points"):
+        parse_deck(deck_text(RECTANGLE, '[curves.c]\nt = [0.0, 1.0]\nvalue = [0.0, 1.0]\nrepeat = 100000000\n'))
+
+
 @pytest.mark.parametrize(("curve", "csv", "expected"), [
     ('file = "gone.csv"\n', None, ["curves.beat.file", "gone.csv' not found"]),
     ('file = "beat.csv"\n', "t,p\n0,1\n1,2\n1,3\n", ["beat.csv' line 4", "strictly increasing", "1 follows 1"]),

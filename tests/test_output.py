@@ -467,3 +467,28 @@ def test_mirror_needs_a_symmetry_plane_and_fibres_a_fibre_law():
         parse_deck(plate + "\n[output]\nmirror = true\n")
     with pytest.raises(DeckError, match="'fibres' draws a fibre-reinforced law's fibres"):
         parse_deck(plate + '\n[output]\nfields = ["displacement", "fibres"]\n')
+
+
+def test_a_static_vtu_series_has_its_times_and_renders_and_its_summary_is_strict_json(tmp_path):
+    """A static run written as VTU only: results.pvd gives every frame its load time as a
+    plain number (ParaView read 'np.float64(0.1)' as 0 and showed only the first frame),
+    ``shellsim render`` reads the series back, and summary.json parses as strict JSON
+    (no NaN for the energies a static run has no balance of)."""
+    import json
+    import xml.etree.ElementTree as ET
+
+    deck = tmp_path / "static.toml"
+    deck.write_text(PLATE.replace('formats = ["xdmf", "vtu"]', 'formats = ["vtu"]')
+                    .replace("end_time = 0.5", 'method = "static"\nend_time = 0.5'))
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert result.exit_code == 0, result.output
+    steps = [item.get("timestep") for item in ET.parse(tmp_path / "out" / "results.pvd").getroot().iter("DataSet")]
+    times = [float(step) for step in steps]
+    assert times == sorted(times) and len(set(times)) == len(times) >= 3 and times[-1] == 0.5
+    rendered = runner.invoke(app, ["render", str(tmp_path / "out"), "--size", "320x240"])
+    assert rendered.exit_code == 0, rendered.output
+
+    def refuse(constant):
+        raise ValueError(f"not strict JSON: {constant}")
+
+    json.loads((tmp_path / "out" / "summary.json").read_text(), parse_constant=refuse)

@@ -4,7 +4,6 @@ repeated for periodic loads, never expressions. Loads and prescribed motions are
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 from typing import Literal
 
@@ -24,7 +23,8 @@ class Curve(Section):
     ``linear`` continues the end segments.
 
     ``file``: a CSV file of (time, value) rows (a path relative to the deck; header lines
-    and ``#`` comments are skipped), its times multiplied by ``time_scale`` and its values
+    and ``#`` comments are skipped; columns separated by semicolons, tabs, commas or
+    spaces, decimal commas read where the columns are not comma-separated), its times multiplied by ``time_scale`` and its values
     by ``value_scale`` into the deck's units (a file in ms into an SI deck takes
     ``time_scale = 0.001``; a pressure in mmHg is a factor of a load of ``value =
     133.322`` Pa). ``repeat``: the table's cycles end to end, a waveform over several
@@ -71,6 +71,9 @@ class Curve(Section):
                 f"'value' has {len(self.value)} entries but 't' has {len(self.t)}; "
                 "give one value per time"
             )
+        if len(self.t) * self.repeat > MOST_POINTS:
+            raise ValueError(f"'repeat' = {self.repeat} cycles of {len(self.t)} points make "
+                             f"{len(self.t) * self.repeat:,} points; at most {MOST_POINTS:,} are expected")
         if self.period is not None and self.period < self.t[-1] - self.t[0]:
             raise ValueError(f"'period' = {self.period} is shorter than the table's span, "
                              f"{self.t[-1] - self.t[0]:g}: one cycle would overlap the next")
@@ -111,30 +114,48 @@ def with_file_tables(curve: Curve, base_dir: Path | None) -> Curve:
     return Curve.model_validate(data)
 
 
+#: The largest waveform file read (a CSV of a million rows is about 20 MB) and the most
+#: points a curve may hold once repeated: a mistyped size or repeat count would otherwise
+#: fill the memory.
+MOST_BYTES, MOST_POINTS = 64 * 2**20, 10**7
+
+
 def read_table(path: Path) -> tuple[list[float], list[float]]:
-    """The (time, value) rows of a CSV file: comma, semicolon, tab or space separated, the
-    first two columns; lines before the first row of numbers (a header) and ``#``
-    comments skipped. Raises ValueError naming the file and line."""
+    """The (time, value) rows of a CSV file, the first two columns; lines before the first
+    row of numbers (a header) and ``#`` comments skipped; a byte-order mark accepted.
+
+    Columns are separated by semicolons, tabs, commas or spaces, the file's first data
+    row deciding which: with semicolons or tabs between the columns, a comma inside a
+    number is a decimal comma (``0,5;80,0`` is 0.5 and 80.0, as spreadsheets in many
+    locales write it); with commas between them, a decimal comma cannot be told from a
+    column and the file must use points. Raises ValueError naming the file and line for
+    a row that is not two finite numbers, decreasing times, a file that is not a regular
+    file or is larger than MOST_BYTES."""
     try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except FileNotFoundError:
-        raise ValueError(f"file '{path}' not found") from None
+        if not path.is_file():
+            raise ValueError(f"file '{path}' not found" if not path.exists() else
+                             f"file '{path}' is not a regular file (a pipe or device cannot be a waveform)")
+        if path.stat().st_size > MOST_BYTES:
+            raise ValueError(f"file '{path}' has {path.stat().st_size / 2**20:.0f} MiB; a waveform table is "
+                             f"expected to be under {MOST_BYTES // 2**20} MiB")
+        lines = path.read_text(encoding="utf-8-sig").splitlines()
     except (OSError, UnicodeDecodeError) as error:
         raise ValueError(f"file '{path}' cannot be read: {getattr(error, 'strerror', None) or error}") from None
     t: list[float] = []
     value: list[float] = []
+    separator = None
     for number, line in enumerate(lines, start=1):
-        fields = [f for f in re.split(r"[,;\s]+", line.split("#")[0].strip()) if f]
-        if not fields:
+        text = line.split("#")[0].strip()
+        if not text:
             continue
-        try:
-            row = [float(f) for f in fields[:2]]
-        except ValueError:
-            row = []
-        if len(row) < 2 or not all(np.isfinite(row)):
+        row = _numbers(text, separator or _separator(text))
+        if row is None:
             if not t:
                 continue  # a header
             raise ValueError(f"file '{path}' line {number}: expected a time and a value, found '{line.strip()}'")
+        separator = separator or _separator(text)
+        if not all(np.isfinite(row)):
+            raise ValueError(f"file '{path}' line {number}: expected finite numbers, found '{line.strip()}'")
         if t and row[0] <= t[-1]:
             raise ValueError(f"file '{path}' line {number}: times must be strictly increasing, but "
                              f"{row[0]:g} follows {t[-1]:g}")
@@ -143,3 +164,27 @@ def read_table(path: Path) -> tuple[list[float], list[float]]:
     if not t:
         raise ValueError(f"file '{path}' holds no (time, value) rows")
     return t, value
+
+
+def _separator(text: str) -> str:
+    """The column separator of a data row: ';', a tab, ',' or spaces (' ')."""
+    for candidate in (";", "\t", ","):
+        if candidate in text:
+            return candidate
+    return " "
+
+
+def _numbers(text: str, separator: str) -> list[float] | None:
+    """The first two columns of a row as numbers (non-finite ones included), or None when
+    they are not numbers (a header). Decimal commas are read where the separator is not
+    a comma."""
+    fields = [f.strip() for f in (text.split() if separator == " " else text.split(separator))]
+    fields = [f for f in fields if f]
+    if len(fields) < 2:
+        return None
+    if separator != ",":
+        fields = [f.replace(",", ".") for f in fields[:2]]
+    try:
+        return [float(f) for f in fields[:2]]
+    except ValueError:
+        return None

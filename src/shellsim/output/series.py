@@ -71,7 +71,7 @@ class VtuSeries:
         root = ET.Element("VTKFile", type="Collection", version="0.1")
         collection = ET.SubElement(root, "Collection")
         for time, file in self.entries:
-            ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
+            ET.SubElement(collection, "DataSet", timestep=repr(float(time)), part="0", file=file)
         write_atomically(self.path, ET.tostring(root, xml_declaration=True))
 
     def close(self) -> None:
@@ -113,7 +113,7 @@ class FrameWriter(Listener):
 
     def on_frame(self, run: Run) -> None:
         point_data, cell_data = self._fields(run)
-        t = run.sim.state.t
+        t = float(run.sim.state.t)  # a numpy scalar would be written as its repr
         for series in self.series:
             try:
                 series.write(t, point_data, cell_data)

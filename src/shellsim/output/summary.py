@@ -4,6 +4,7 @@ and left out, and each reference check."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -87,5 +88,17 @@ def element_quality(run: Run) -> dict:
 
 
 def write_json(data: dict, path: Path) -> None:
-    """Write ``data`` as JSON, atomically."""
-    write_atomically(path, json.dumps(data, indent=2, allow_nan=True) + "\n")
+    """Write ``data`` as strict JSON, atomically: a number that is not finite (an energy
+    balance with nothing to balance, a ratio of zeros) is written as null."""
+    write_atomically(path, json.dumps(_finite(data), indent=2, allow_nan=False) + "\n")
+
+
+def _finite(value):
+    """``value`` with every non-finite float inside it replaced by None."""
+    if isinstance(value, dict):
+        return {key: _finite(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(item) for item in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

@@ -139,3 +139,14 @@ def test_run_of_the_default_scene_completes_and_reports_its_volume(tmp_path):
     assert summary["status"] == "completed"
     assert abs(summary["volume_change_percent"]) < 1.0
     assert abs(summary["energy"]["balance_error_percent"]) < 1.0
+
+
+def test_help_texts_keep_their_defaults_and_units():
+    """Rich markup ate every bracketed default and unit of the option texts ('Output folder
+    .'); the help is plain text now, each option with its default."""
+    ran = runner.invoke(app, ["run", "--help"])
+    assert ran.exit_code == 0 and "[default: results/DECK-NAME]" in " ".join(ran.output.split())
+    assert "<bool>" not in ran.output and "static" in ran.output
+    rendered = runner.invoke(app, ["render", "--help"])
+    said = " ".join(rendered.output.split())
+    assert "[default: RESULTS/renders]" in said and "[default: 1200x900]" in said

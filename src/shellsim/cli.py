@@ -29,6 +29,8 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # plain help: rich markup ate every "[default: ...]" and "[unit]" the option texts give
+    rich_markup_mode=None,
 )
 out = Console()
 err = Console(stderr=True)
@@ -172,7 +174,8 @@ def run(
     out_dir: Annotated[Path | None, typer.Option("--out", help="Output folder [default: results/DECK-NAME].")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
-    """Integrate a scene in time (explicit central differences). Writes OUT/summary.json,
+    """Run a scene: in time by explicit central differences, or as equilibria by Newton
+    load steps (solver.method = "static"). Writes OUT/summary.json,
     OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
     and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
     reference check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM

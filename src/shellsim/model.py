@@ -85,8 +85,9 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     constraints, e1f0 = _boundary_conditions(deck, mesh)
     curves = _curve_tables(deck)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
-    loads = build_loads(deck.load, LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
-                                             curve_index=deck.curve_index))
+    loads = build_loads({"load": deck.load, "contact": deck.contact},
+                        LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
+                                  curve_index=deck.curve_index))
     return Model(
         rule=rule, body=body, material=_material(deck, mesh, rule), loads=loads, curves=curves,
         constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0,

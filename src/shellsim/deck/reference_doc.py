@@ -14,6 +14,7 @@ from .curves import Curve
 from .geometry import BUILDERS
 from ..materials.axes import CentrelineAxes, CylindricalAxes, FixedAxes, MeshAxes
 from .material import MATERIALS
+from ..loads import CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
 from ..table_types import tag_of
 
@@ -71,6 +72,9 @@ def deck_reference() -> str:
     lines += ["## [[load]]", "", "Chosen by `type`; a load is `value * curve(t)`, constant without a curve "
               "(growing from 0 over a static solve).", ""]
     for cls in LOAD_TABLES:
+        lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
+    lines += ["## [[contact]]", "", "Chosen by `type`; the shell's faces against what they may not pass.", ""]
+    for cls in CONTACT_TABLES:
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")

@@ -76,16 +76,23 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
     for i, bc in enumerate(deck.boundary):
         need_set(f"boundary[{i}].set", bc.set)
         need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))
-    for i, load in enumerate(deck.load):
-        need_set(f"load[{i}].set", load.set, load.SET_KINDS)
-        need_curve(f"load[{i}].curve", load.curve)
+    for key in ("load", "contact"):
+        for i, table in enumerate(getattr(deck, key)):
+            need_set(f"{key}[{i}].set", table.set, table.SET_KINDS)
+            need_curve(f"{key}[{i}].curve", table.curve)
     factors = list(load_factor_columns(deck))
+    columns = factors + [p.name for p in deck.output.probe]
+    for i, contact in enumerate(deck.contact):
+        if contact.name in columns:
+            problems.append(f"contact[{i}].name: '{contact.name}' is already a history column (a probe's or a "
+                            "curve's load factor); choose another name")
+        columns.append(contact.name)
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)
         if probe.name in factors:
             problems.append(f"output.probe[{i}].name: '{probe.name}' is the history's column of a curve's load "
                             "factor; choose another name")
-    probes = [p.name for p in deck.output.probe] + factors
+    probes = [p.name for p in deck.output.probe] + factors + [c.name for c in deck.contact]
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:
             problems.append(

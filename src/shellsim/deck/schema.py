@@ -14,6 +14,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 from .curves import Curve
 from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
+from ..loads import CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
 from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
 
@@ -137,8 +138,14 @@ class Prescribed(Section):
 Boundary = Annotated[Union[Clamped, Fixed, Symmetry, Prescribed], Field(discriminator="type")]
 
 
-#: A ``[[load]]`` table, chosen by ``type`` among every registered load kind's tables.
-Load = Annotated[Union[LOAD_TABLES], Field(discriminator="type")]
+def _chosen_by_type(tables: tuple) -> object:
+    """The item of a deck list: its one table, or its tables chosen by ``type``."""
+    return tables[0] if len(tables) == 1 else Annotated[Union[tables], Field(discriminator="type")]
+
+
+#: A ``[[load]]`` and a ``[[contact]]`` table, among every registered kind's tables.
+Load = _chosen_by_type(LOAD_TABLES)
+Contact = _chosen_by_type(CONTACT_TABLES)
 
 
 class Static(Section):
@@ -424,6 +431,7 @@ class Deck(Section):
     section: ShellSection
     boundary: list[Boundary] = []
     load: list[Load] = []
+    contact: list[Contact] = []
     curves: dict[Name, Curve] = {}
     solver: Solver
     output: Output = Output()

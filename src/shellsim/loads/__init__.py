@@ -3,8 +3,9 @@
 :func:`external_forces` and :func:`add_load_tangents`.
 
 A kind is a module of this package with
-- ``TABLES``: its ``[[load]]`` deck tables (:class:`~shellsim.loads.table.LoadTable`,
-  ``type`` their tag; the deck's load union is every kind's tables);
+- ``TABLES``: its deck tables (:class:`~shellsim.loads.table.LoadTable`, ``type`` their
+  tag), ``[[load]]`` or ``[[contact]]`` ones (their ``DECK_KEY``; the deck's unions are
+  every kind's tables);
 - ``build(table, scene)``: one table's loads on the mesh (``scene`` a :class:`LoadScene`),
   as the ``Bundle`` of this kind or of another one (a dead pressure is tabulated as
   nodal forces, a mapped pressure is a follower pressure with values of its own);
@@ -14,7 +15,12 @@ and, when it has kernels of its own,
 - compiled ``add_forces(t, model, shape, bundle, f, g)``: its translational and
   director-conjugate forces f, g (n, 3) at time t added;
 - compiled ``add_tangent(t, model, shape, bundle, step_u, step_r, k)`` where its forces
-  depend on the shape: less their derivative, into the elements' blocks k (ne, 45, 45).
+  depend on the shape: less their derivative, into the elements' blocks k (ne, 45, 45);
+- where it is a penalty (contact): ``calibrate(bundle, masses, rotary, h, dt)``, its
+  springs from the masses and the structure's critical step when the run starts,
+  ``step_share(bundle)``, the share of that step it leaves stable, and compiled
+  ``item_forces(t, curves, shape, bundle, out)`` with a ``tool`` field, the force each
+  of its tables takes (history columns by the tables' names).
 Adding a kind is writing its module and adding it to :data:`KINDS`.
 """
 
@@ -29,29 +35,30 @@ from ..bundles import Body, Curves, Rule, Shape
 from ..compiled_call import TypedCall
 from ..element.frames import to_rotational
 from ..errors import MeshError
-from . import edge_pressure, mapped_pressure, nodal, pressure
+from . import edge_pressure, mapped_pressure, nodal, pressure, rigid_tool
 
 #: The kinds, in the order their forces are added.
-KINDS = (nodal, pressure, edge_pressure, mapped_pressure)
+KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool)
 
 #: The kinds with kernels of their own: the fields of :data:`Loads`.
 CARRIERS = tuple(kind for kind in KINDS if hasattr(kind, "Bundle"))
 
-#: Every ``[[load]]`` deck table, and the kind that builds each.
-TABLES = tuple(table for kind in KINDS for table in kind.TABLES)
+#: Every ``[[load]]`` and ``[[contact]]`` deck table, and the kind that builds each.
+TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "load")
+CONTACT_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "contact")
 _KIND_OF = {table: kind for kind in KINDS for table in kind.TABLES}
 
 #: Every load of a scene (:class:`shellsim.bundles.Model`'s ``loads``): one bundle per
 #: carrying kind, named after its module.
 Loads = NamedTuple("Loads", [(kind.__name__.rsplit(".", 1)[1], kind.Bundle) for kind in CARRIERS])
 
-DeckLoad = Union[TABLES]
 
 
 class LoadScene(NamedTuple):
     """What a kind's ``build`` reads: the mesh (:class:`shellsim.mesh.Mesh`), the element's
     rule and body, the initial shape, the curve tables and ``curve_index(name)``, a curve's
-    place in them (a load without a curve: the static ramp's or -1)."""
+    place in them (a load without a curve: the static ramp's or -1); place: the table's
+    place in its deck list."""
 
     mesh: object
     rule: Rule
@@ -59,17 +66,20 @@ class LoadScene(NamedTuple):
     initial: Shape
     curves: Curves
     curve_index: Callable[[Union[str, None]], int]
+    place: int = 0
 
 
-def build_loads(loads: list[DeckLoad], scene: LoadScene) -> Loads:
-    """The deck's ``loads`` as the kernels' tables, in deck order within each kind."""
+def build_loads(tables: dict[str, list], scene: LoadScene) -> Loads:
+    """The deck's lists of tables (``load``, ``contact``) as the kernels' tables, in deck
+    order within each kind."""
     parts: dict[type, list] = {kind.Bundle: [] for kind in CARRIERS}
-    for i, table in enumerate(loads):
-        try:
-            made = _KIND_OF[type(table)].build(table, scene)
-        except MeshError as error:
-            raise MeshError(f"load[{i}] ({table.type} on '{table.set}'): {error}") from None
-        parts[type(made)].append(made)
+    for key, listed in tables.items():
+        for i, table in enumerate(listed):
+            try:
+                made = _KIND_OF[type(table)].build(table, scene._replace(place=i))
+            except MeshError as error:
+                raise MeshError(f"{key}[{i}] ({table.type} on '{table.set}'): {error}") from None
+            parts[type(made)].append(made)
     return Loads(*(_concatenate(parts[kind.Bundle]) if parts[kind.Bundle] else kind.empty(scene) for kind in CARRIERS))
 
 
@@ -78,12 +88,44 @@ def _concatenate(bundles: list) -> NamedTuple:
     return type(bundles[0])(*(np.concatenate(fields) for fields in zip(*bundles)))
 
 
-def features(loads: list[DeckLoad]) -> dict[str, bool]:
-    """Every load feature of the plan (:mod:`shellsim.plan`), True where ``loads`` use it."""
-    used = {name: False for table in TABLES for name in table.FEATURES}
-    for load in loads:
-        used[load.feature] = True
+def features(tables: list) -> dict[str, bool]:
+    """Every load and contact feature of the plan (:mod:`shellsim.plan`), True where
+    ``tables`` use it."""
+    used = {name: False for table in TABLES + CONTACT_TABLES for name in table.FEATURES}
+    for table in tables:
+        used[table.feature] = True
     return used
+
+
+def calibrate(model, masses: np.ndarray, rotary: np.ndarray, dt: float) -> None:
+    """Set the penalty springs of every kind that has them, in place, from the lumped
+    masses and rotary masses (n,) and the structure's critical step ``dt``."""
+    for kind, bundle in zip(CARRIERS, model.loads):
+        if hasattr(kind, "calibrate") and any(len(field) for field in bundle):
+            kind.calibrate(bundle, masses, rotary, model.h0, dt)
+
+
+def step_share(model) -> float:
+    """The share of the structure's critical step that stays stable with every penalty."""
+    return min((kind.step_share(bundle) for kind, bundle in zip(CARRIERS, model.loads)
+                if hasattr(kind, "step_share")), default=1.0)
+
+
+class ToolForces:
+    """The magnitude of the total force each contact table's tool takes, by the table's
+    ``name`` (history columns), from the kinds' compiled ``item_forces``."""
+
+    def __init__(self, model, names: list[str]):
+        self.model, self.names = model, names
+        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)))
+                       for kind, bundle in zip(CARRIERS, model.loads) if hasattr(kind, "item_forces") and len(bundle.tool)]
+
+    def __call__(self, t: float, shape: Shape) -> dict[str, float]:
+        totals = np.zeros((len(self.names), 3))
+        for item_forces, bundle, out in self._calls:
+            item_forces(float(t), self.model.curves, shape, bundle, out)
+            np.add.at(totals, bundle.tool, out)
+        return {name: float(np.linalg.norm(total)) for name, total in zip(self.names, totals)}
 
 
 def _chained(name: str, position: int = 0):

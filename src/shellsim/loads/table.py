@@ -9,14 +9,16 @@ from ..table_types import Section
 
 
 class LoadTable(Section):
-    """A load ``value * curve(t)`` on a named set (``set`` and ``curve`` are each
-    table's own keys, with their defaults).
+    """A load (``value * curve(t)``) or a contact on a named set (``set`` and ``curve``
+    are each table's own keys, with their defaults).
 
+    DECK_KEY: the deck's list it goes in, ``load`` ([[load]]) or ``contact`` ([[contact]]);
     SET_KINDS: the kinds of set it acts on (:mod:`shellsim.deck.references` checks them);
     FEATURES: the plan's features (:mod:`shellsim.plan`) this table may use, the first
     unless :attr:`feature` says otherwise; QUANTITY: what ``value`` is, for plot axes:
     "stress" (force per area) or "load"."""
 
+    DECK_KEY: ClassVar[str] = "load"
     SET_KINDS: ClassVar[tuple[str, ...]]
     FEATURES: ClassVar[tuple[str, ...]]
     QUANTITY: ClassVar[str] = "load"

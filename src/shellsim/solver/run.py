@@ -21,6 +21,7 @@ from ..curve_tables import factor
 from ..deck import Deck
 from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
+from ..loads import ToolForces, calibrate, step_share
 from ..mesh import Mesh
 from ..model import Model
 from .probes import Probe, probe_value, resolve_probes
@@ -62,6 +63,7 @@ class Run:
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
     load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
+    tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
 
     @property
     def load_time(self) -> float:
@@ -145,12 +147,19 @@ class Timed(Listener):
 
 
 def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
-    """A run ready to start: simulation built, probes resolved."""
+    """A run ready to start: simulation built, probes resolved, contact springs set from
+    the masses and the structure's critical step (:func:`shellsim.loads.calibrate`)."""
     probes = resolve_probes(deck.output.probe, mesh, model)
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
               quality=ElementQuality(mesh))
     run.load_factors = load_factor_columns(deck)
-    run.history = {p.name: [] for p in probes} | {name: [] for name in run.load_factors}
+    names = [contact.name for contact in deck.contact]
+    run.history = {p.name: [] for p in probes} | {name: [] for name in run.load_factors} | {n: [] for n in names}
+    if names:
+        s = run.sim.state
+        calibrate(model, s.mt, s.mr, run.sim.critical_time_step())
+        run.sim.evaluate_forces()  # the springs act from the start
+        run.tool_forces = ToolForces(model, names)
     return run
 
 
@@ -175,6 +184,9 @@ def _record(run: Run, listener: Listener) -> None:
         run.history[p.name].append(probe_value(run.sim, p))
     for name, index in run.load_factors.items():
         run.history[name].append(factor(run.model.curves, index, run.load_time))
+    if run.tool_forces is not None:
+        for name, force in run.tool_forces(run.load_time, run.sim.state.fields.shape).items():
+            run.history[name].append(force)
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
 
@@ -204,7 +216,7 @@ def _update_time_step(run: Run, listener: Listener) -> None:
     if run.lowest is None or run.worst.ratio < run.lowest.ratio:
         run.lowest = run.worst
     run.sim.update_masses()
-    run.dt_critical = run.sim.critical_time_step()
+    run.dt_critical = run.sim.critical_time_step() * step_share(run.model)
     run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
     listener.on_dt(run)

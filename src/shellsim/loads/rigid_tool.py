@@ -1,0 +1,256 @@
+"""Contact of the shell's faces with a rigid tool: an analytic plane, sphere or cylinder
+that a curve may move (the rigid walls of LS-DYNA), by penalty.
+
+Each node of the contact set is tested on the faces it offers, the points
+y = x + t h/2 d (t = -1 bottom, +1 top, 0 the mid-surface), against the tool's signed
+distance phi(y) (positive on the side the shell belongs to). Where phi < 0 the face point
+is pushed out along the tool's normal n with the force -k phi n, which acts where the
+face is: on the node's translations and, through its lever arm t h/2, on its director
+(as a face pressure does). Frictionless.
+
+The penalty is the soft constraint of explicit codes: each node's spring is
+k = s / (dt_c^2 (1/m + (h/2)^2 / m_r)), dt_c the structure's critical step, m and m_r the
+node's translational and rotary masses (the face point moves by both), s =
+``penalty``. Adding such springs raises the highest frequency squared by at most
+s / dt_c^2 = (s / 4) omega_max^2, so the critical step is taken as dt_c / sqrt(1 + s / 4)
+(0.988 dt_c for the default s = 0.1): contact never lowers it by more. The springs are
+set once, when the run starts (:func:`calibrate`), so the contact force is conservative:
+its work, counted with the external work, is the spring energy.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal, NamedTuple
+
+import numpy as np
+from numba import njit
+from pydantic import model_validator
+
+from ..curve_tables import factor
+from ..element.frames import cross
+from ..element.tangent import moved_node
+from ..table_types import Name, Positive, Vec3
+from .table import LoadTable
+
+#: Codes of the tools' shapes.
+SHAPES = {"plane": 0, "sphere": 1, "cylinder": 2}
+#: (first, last) face of each ``faces`` choice, stepped by 2.
+FACE_RANGES = {"both": (-1, 1), "bottom": (-1, -1), "top": (1, 1), "mid": (0, 0)}
+
+
+class RigidTool(LoadTable):
+    """A rigid tool the faces of a surface set may not pass: ``shape = "plane"`` through
+    ``point`` with unit ``normal`` pointing to the shell's side; ``"sphere"`` of ``radius``
+    centred at ``point``; ``"cylinder"`` of ``radius`` about the line through ``point``
+    along ``axis``. The shell is kept ``outside`` the sphere or cylinder (a punch, a
+    stent's outside) or ``inside`` it (a vessel in a tube). The tool moves by ``motion *
+    curve(t)``. ``faces``: the shell's faces that touch it (``both``, ``bottom``, ``top``
+    or the ``mid`` surface). ``penalty``: the soft constraint's scale s (the critical step
+    falls by the factor 1 / sqrt(1 + s / 4)). ``name``: the history column of the force
+    the tool takes (its magnitude)."""
+
+    type: Literal["rigid_tool"]
+    name: Name
+    set: Name = "all"
+    shape: Literal["plane", "sphere", "cylinder"]
+    point: Vec3 = (0.0, 0.0, 0.0)
+    normal: Vec3 | None = None
+    axis: Vec3 | None = None
+    radius: Positive | None = None
+    side: Literal["outside", "inside"] = "outside"
+    motion: Vec3 = (0.0, 0.0, 0.0)
+    curve: Name | None = None
+    faces: Literal["both", "bottom", "top", "mid"] = "both"
+    penalty: Positive = 0.1
+    DECK_KEY: ClassVar[str] = "contact"
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
+    FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
+
+    @model_validator(mode="after")
+    def _shape_keys(self) -> "RigidTool":
+        needs = {"plane": ("normal",), "sphere": ("radius",), "cylinder": ("axis", "radius")}[self.shape]
+        missing = [key for key in needs if getattr(self, key) is None]
+        extra = [key for key in ("normal", "axis", "radius") if key not in needs and getattr(self, key) is not None]
+        if missing or extra:
+            raise ValueError(f"shape = '{self.shape}' takes {', '.join(needs)}"
+                             + (f"; missing {', '.join(missing)}" if missing else "")
+                             + (f"; {', '.join(extra)} is not for it" if extra else ""))
+        for key in ("normal", "axis"):
+            vector = getattr(self, key)
+            if vector is not None and not any(vector):
+                raise ValueError(f"{key} = {list(vector)} has no direction; give a nonzero vector")
+        if self.shape == "plane" and self.side != "outside":
+            raise ValueError("a plane keeps the shell on its normal's side; give the normal that way round")
+        return self
+
+
+TABLES = (RigidTool,)
+
+
+class Bundle(NamedTuple):
+    """The contact nodes (K,) of every rigid tool: nodes; tool (K,) the tool's place among
+    the deck's contacts; shape (K,) code of SHAPES; point, direction (K, 3) the tool's
+    point and its plane normal or cylinder axis (unit); radius, side (K,) (+1 outside, -1
+    inside); motion (K, 3) and curve (K,) its motion; faces (K, 2) the first and last face
+    tested; penalty (K,) the scale s; stiffness (K,) the springs k [force/length] (0 until
+    :func:`calibrate`)."""
+
+    nodes: np.ndarray
+    tool: np.ndarray
+    shape: np.ndarray
+    point: np.ndarray
+    direction: np.ndarray
+    radius: np.ndarray
+    side: np.ndarray
+    motion: np.ndarray
+    curve: np.ndarray
+    faces: np.ndarray
+    penalty: np.ndarray
+    stiffness: np.ndarray
+
+
+#: The bundle's fields that hold integers.
+_INTEGERS = ("tool", "shape", "curve", "faces")
+
+
+def empty(scene) -> Bundle:
+    """No rigid tool."""
+    return _repeated(np.zeros(0, dtype=np.int64), tool=-1, shape=0, point=np.zeros(3), direction=np.zeros(3),
+                     radius=0.0, side=1.0, motion=np.zeros(3), curve=-1, faces=(0, 0), penalty=0.1)
+
+
+def build(table: RigidTool, scene) -> Bundle:
+    """The contact nodes of one tool: the nodes of its set."""
+    direction = np.asarray(table.normal if table.shape == "plane" else table.axis or (0.0, 0.0, 1.0), dtype=float)
+    return _repeated(scene.mesh.sets[table.set].nodes.astype(np.int64), tool=scene.place, shape=SHAPES[table.shape],
+                     point=table.point, direction=direction / np.linalg.norm(direction), radius=table.radius or 0.0,
+                     side=1.0 if table.side == "outside" else -1.0, motion=table.motion,
+                     curve=scene.curve_index(table.curve), faces=FACE_RANGES[table.faces], penalty=table.penalty)
+
+
+def _repeated(nodes: np.ndarray, **tool) -> Bundle:
+    """A :class:`Bundle` of one tool's ``nodes`` (K,), its values (every field but the nodes
+    and the springs) repeated for each."""
+    def each(name, value):
+        value = np.asarray(value, dtype=np.int64 if name in _INTEGERS else float)
+        return np.broadcast_to(value, (len(nodes),) + value.shape).copy()
+
+    return Bundle(nodes=nodes, stiffness=np.zeros(len(nodes)), **{name: each(name, value) for name, value in tool.items()})
+
+
+def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarray, dt: float) -> None:
+    """Set the springs, in place: k = s / (dt^2 (1/m + (h/2)^2 / m_r)) at each contact
+    node, from the translational and rotary masses (n,), the fibre lengths h (n,) and the
+    structure's critical step dt (the lever arm only where a face off the mid-surface
+    touches)."""
+    n = loads.nodes
+    arm = np.where(loads.faces[:, 0] != 0, 0.5 * h[n], 0.0) ** 2
+    compliance = 1.0 / masses[n] + np.where(rotary[n] > 0.0, arm / np.where(rotary[n] > 0.0, rotary[n], 1.0), 0.0)
+    loads.stiffness[:] = loads.penalty / (dt * dt * compliance)
+
+
+def step_share(loads: Bundle) -> float:
+    """The share of the structure's critical step that stays stable with the springs."""
+    return float(1.0 / np.sqrt(1.0 + loads.penalty.max() / 4.0)) if len(loads.penalty) else 1.0
+
+
+@njit(cache=True, inline="always")
+def _distance(loads, m, centre, y, normal):
+    """The signed distance of the point y (3,) from tool item m whose point is now
+    ``centre`` (3,), positive on the shell's side; writes the unit normal (3,) there."""
+    shape = loads.shape[m]
+    if shape == 0:
+        normal[:] = loads.direction[m]
+        return (y[0] - centre[0]) * normal[0] + (y[1] - centre[1]) * normal[1] + (y[2] - centre[2]) * normal[2]
+    for i in range(3):
+        normal[i] = y[i] - centre[i]
+    if shape == 2:  # off the axis only
+        along = normal[0] * loads.direction[m, 0] + normal[1] * loads.direction[m, 1] + normal[2] * loads.direction[m, 2]
+        for i in range(3):
+            normal[i] -= along * loads.direction[m, i]
+    size = np.sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2])
+    for i in range(3):
+        normal[i] *= loads.side[m] / size
+    return loads.side[m] * (size - loads.radius[m])
+
+
+@njit(cache=True)
+def _node_forces(loads, m, centre, x, d, h, f, g):
+    """f, g (3,) = the contact force on item m's node at x, d (3,), h, and its
+    director-conjugate part, from the faces the item tests."""
+    y, normal = np.empty(3), np.empty(3)
+    f[:] = 0.0
+    g[:] = 0.0
+    face = loads.faces[m, 0]
+    while face <= loads.faces[m, 1]:
+        arm = 0.5 * face * h
+        for i in range(3):
+            y[i] = x[i] + arm * d[i]
+        gap = _distance(loads, m, centre, y, normal)
+        if gap < 0.0:
+            push = -loads.stiffness[m] * gap
+            for i in range(3):
+                f[i] += push * normal[i]
+                g[i] += arm * push * normal[i]
+        face += 2
+
+
+@njit(cache=True)
+def _centre(loads, curves, m, t, centre):
+    """Item m's tool point at time t into centre (3,)."""
+    c = factor(curves, loads.curve[m], t)
+    for i in range(3):
+        centre[i] = loads.point[m, i] + c * loads.motion[m, i]
+
+
+@njit(cache=True)
+def add_forces(t, model, shape, loads, f, g):
+    """f, g (n, 3) += the tools' contact forces at time t on the current ``shape``."""
+    centre, fn, gn = np.empty(3), np.empty(3), np.empty(3)
+    for m in range(loads.nodes.shape[0]):
+        node = loads.nodes[m]
+        _centre(loads, model.curves, m, t, centre)
+        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], fn, gn)
+        for i in range(3):
+            f[node, i] += fn[i]
+            g[node, i] += gn[i]
+
+
+@njit(cache=True)
+def item_forces(t, curves, shape, loads, out):
+    """out (K, 3): each contact node's force at time t (for the tools' measures)."""
+    centre, gn = np.empty(3), np.empty(3)
+    for m in range(loads.nodes.shape[0]):
+        node = loads.nodes[m]
+        _centre(loads, curves, m, t, centre)
+        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], out[m], gn)
+
+
+@njit(cache=True)
+def add_tangent(t, model, shape, loads, step_u, step_r, k):
+    """k (ne, 45, 45) -= the derivative of each contact node's force and rotational force
+    with respect to its five DOFs (central differences, order and steps as
+    :mod:`shellsim.element.tangent`), into its diagonal block in the first element
+    holding it; a node out of contact adds nothing."""
+    body = model.body
+    centre, fn, gn = np.empty(3), np.empty(3), np.empty(3)
+    xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
+    block = np.empty((5, 5))
+    for m in range(loads.nodes.shape[0]):
+        node = loads.nodes[m]
+        _centre(loads, model.curves, m, t, centre)
+        block[:] = 0.0
+        for move in range(10):
+            step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move, (step_u, step_r), (xm, dm, e1m))
+            _node_forces(loads, m, centre, xm, dm, shape.h[node], fn, gn)
+            weight = 1.0 / (2.0 * step)
+            e2 = cross(dm, e1m)
+            column = move // 2
+            for i in range(3):
+                block[i, column] += weight * fn[i]
+                block[3, column] -= weight * e1m[i] * gn[i]
+                block[4, column] -= weight * e2[i] * gn[i]
+        e, a = divmod(body.slots[body.node_slots[node]], 9)
+        for i in range(5):
+            for j in range(5):
+                k[e, 5 * a + i, 5 * a + j] -= block[i, j]

@@ -177,3 +177,18 @@ def test_a_tool_the_scene_cannot_use_is_named_in_the_deck(keys, expected):
     with pytest.raises(DeckError) as caught:
         parse_deck(text)
     assert expected in str(caught.value)
+
+
+def test_check_names_each_tool_with_its_cost(tmp_path):
+    from typer.testing import CliRunner
+
+    from shellsim.cli import app
+
+    deck = tmp_path / "tool.toml"
+    deck.write_text(deck_text(PLATE, '[[contact]]\ntype = "rigid_tool"\nname = "punch"\nshape = "sphere"\n'
+                                     'radius = 0.3\npoint = [0.5, 0.5, -0.4]\nmotion = [0.0, 0.0, 0.2]\n'))
+    checked = CliRunner().invoke(app, ["check", str(deck)])
+    said = " ".join(checked.output.replace("│", " ").split())  # the summary table's cells, unwrapped
+    assert checked.exit_code == 0, checked.output
+    assert "'punch': rigid sphere of radius 0.3 at [0.5, 0.5, -0.4], the shell outside, moving by [0.0, 0.0, 0.2]" in said
+    assert "penalty 0.1, the critical step x 0.988 (" in said and " nodes)" in said

@@ -448,6 +448,8 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     for load in scene.load:
         curve = f" x curve '{load.curve}'" if load.curve else ""
         table.add_row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
+    for contact in scene.contact:
+        table.add_row("contact", f"{contact.summary} ({len(built.sets[contact.set].nodes)} nodes)")
     sv = scene.solver
     if sv.method == "static":
         st = sv.static

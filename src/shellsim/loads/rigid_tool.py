@@ -83,6 +83,18 @@ class RigidTool(LoadTable):
             raise ValueError("a plane keeps the shell on its normal's side; give the normal that way round")
         return self
 
+    @property
+    def summary(self) -> str:
+        """One line for ``shellsim check``: the tool, its motion, the faces and the cost."""
+        where = {"plane": f"through {list(self.point)} facing {list(self.normal or ())}",
+                 "sphere": f"of radius {self.radius} at {list(self.point)}, the shell {self.side}",
+                 "cylinder": f"of radius {self.radius} about {list(self.axis or ())} through {list(self.point)}, "
+                             f"the shell {self.side}"}[self.shape]
+        moving = f", moving by {list(self.motion)}" + (f" x curve '{self.curve}'" if self.curve else "") \
+            if any(self.motion) else ""
+        return (f"'{self.name}': rigid {self.shape} {where}{moving}; {self.faces} faces of '{self.set}'; "
+                f"penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}")
+
 
 TABLES = (RigidTool,)
 
@@ -151,7 +163,13 @@ def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarr
 
 def step_share(loads: Bundle) -> float:
     """The share of the structure's critical step that stays stable with the springs."""
-    return float(1.0 / np.sqrt(1.0 + loads.penalty.max() / 4.0)) if len(loads.penalty) else 1.0
+    return share_of(loads.penalty.max()) if len(loads.penalty) else 1.0
+
+
+def share_of(penalty: float) -> float:
+    """The share of the critical step that stays stable with springs of scale ``penalty``:
+    1 / sqrt(1 + s / 4)."""
+    return float(1.0 / np.sqrt(1.0 + penalty / 4.0))
 
 
 @njit(cache=True, inline="always")

@@ -112,20 +112,32 @@ def step_share(model) -> float:
 
 
 class ToolForces:
-    """The magnitude of the total force each contact table's tool takes, by the table's
-    ``name`` (history columns), from the kinds' compiled ``item_forces``."""
+    """The contact tools' forces from the kinds' compiled ``item_forces``: the magnitude of
+    the total each contact table's tool takes, by the table's ``name`` (history columns),
+    and the force at each node (output fields)."""
 
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
         self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)))
                        for kind, bundle in zip(CARRIERS, model.loads) if hasattr(kind, "item_forces") and len(bundle.tool)]
 
-    def __call__(self, t: float, shape: Shape) -> dict[str, float]:
-        totals = np.zeros((len(self.names), 3))
+    def _items(self, t: float, shape: Shape):
         for item_forces, bundle, out in self._calls:
             item_forces(float(t), self.model.curves, shape, bundle, out)
+            yield bundle, out
+
+    def __call__(self, t: float, shape: Shape) -> dict[str, float]:
+        totals = np.zeros((len(self.names), 3))
+        for bundle, out in self._items(t, shape):
             np.add.at(totals, bundle.tool, out)
         return {name: float(np.linalg.norm(total)) for name, total in zip(self.names, totals)}
+
+    def at_nodes(self, t: float, shape: Shape) -> np.ndarray:
+        """(n, 3) the contact force on each node at time t."""
+        forces = np.zeros((self.model.n_nodes, 3))
+        for bundle, out in self._items(t, shape):
+            np.add.at(forces, bundle.nodes, out)
+        return forces
 
 
 def _chained(name: str, position: int = 0):

@@ -25,6 +25,7 @@ from ..materials.laws import LAWS
 from ..mesh import layer_geometry
 from ..model import Model
 from ..solver.simulation import Simulation
+from ..loads import ToolForces
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
@@ -32,6 +33,7 @@ CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrang
 #: fibre_1, fibre_2, ...
 FIBRES, FIBRE_PREFIX = "fibres", "fibre_"
 NODAL_SUFFIX = "_nodal"
+CONTACT_PRESSURE = "contact_pressure"
 #: Fields the shell view shows as their largest value through the thickness (a bent
 #: shell's equivalent stress peaks at its faces); the others as the thickness mean.
 LARGEST_THROUGH_THICKNESS = ("von_mises",)
@@ -39,7 +41,7 @@ LARGEST_THROUGH_THICKNESS = ("von_mises",)
 #: What each field or probe quantity measures, for units in titles and axis labels.
 FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
-              "von_mises": "stress", "time": "time"}
+              "von_mises": "stress", "contact_pressure": "stress", "time": "time"}
 #: Units of each kind per deck unit system (meta.units); nothing is converted.
 UNITS = {"SI": {"length": "m", "stress": "Pa", "time": "s"},
          "mm-t-s": {"length": "mm", "stress": "MPa", "time": "s"},
@@ -139,6 +141,19 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
+def contact_pressure(sim: Simulation) -> np.ndarray:
+    """(n,) the contact tools' force on each node over the node's share of the initial
+    mid-surface, int N_a dA: the pressure the tools put on the shell."""
+    model, state, rule = sim.model, sim.state, sim.model.rule
+    nq = len(rule.wq)
+    jac = layer_geometry(model.x0, model.d0, model.h0, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], 0.0)[1]
+    area = np.linalg.norm(np.cross(jac[..., 0], jac[..., 1]), axis=-1) * rule.wq  # (ne, nq)
+    shares = np.zeros(model.n_nodes)
+    np.add.at(shares, model.conn, area @ rule.N[:nq])
+    forces = ToolForces(model, []).at_nodes(state.t, state.fields.shape)
+    return np.linalg.norm(forces, axis=1) / shares
+
+
 def fibre_directions(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
     """Each fibre family's current unit direction at every in-plane integration point of
     the ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family:
@@ -197,6 +212,8 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
+    if CONTACT_PRESSURE in fields:
+        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim), model.conn, len(mesh.layers))
     if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
         for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),

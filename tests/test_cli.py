@@ -150,3 +150,22 @@ def test_help_texts_keep_their_defaults_and_units():
     rendered = runner.invoke(app, ["render", "--help"])
     said = " ".join(rendered.output.split())
     assert "[default: RESULTS/renders]" in said and "[default: 1200x900]" in said
+
+
+def test_deck_text_is_shown_as_written_never_read_as_markup_or_tex(tmp_path):
+    """A title with a stray closing tag and an unclosed formula ended check in rich's
+    MarkupError and plot in matplotlib's TeX parser; both show it as written."""
+    title = "A [/bold] plate $\\\\alpha^{2$"
+    deck = tmp_path / "odd.toml"
+    deck.write_text(deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0', '[[boundary]]\ntype = "clamped"\n'
+                              'set = "x0"\n[[load]]\ntype = "pressure"\nvalue = 1.0e-6\n[[output.probe]]\nname = "tip"\n'
+                              'quantity = "displacement"\nset = "x1y0"\ncomponent = "z"\n')
+                    .replace('title = "test scene"', f'title = "{title}"')
+                    .replace("end_time = 1.0", 'method = "static"\nend_time = 1.0'))
+    checked = runner.invoke(app, ["check", str(deck)])
+    assert checked.exit_code == 0 and "A [/bold] plate $\\alpha^{2$" in checked.output, checked.output
+    ran = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
+    assert ran.exit_code == 0, ran.output
+    plotted = runner.invoke(app, ["plot", str(tmp_path / "out")])
+    assert plotted.exit_code == 0, plotted.output
+    assert (tmp_path / "out" / "plots" / "tip.png").exists() and (tmp_path / "out" / "plots" / "energy.png").exists()

@@ -423,61 +423,65 @@ THIN_SHELL_GAIN = 2.0
 def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     from .solver.outlook import duration, size_text
 
-    table = Table(title=scene.meta.title, show_header=False, title_justify="left")
+    table = Table(title=escape(scene.meta.title), show_header=False, title_justify="left")
     table.add_column(style="bold")
     table.add_column()
+
+    def row(label: str, text: str) -> None:  # deck text is shown as written, never read as markup
+        table.add_row(label, escape(text))
+
     g = scene.geometry
     params = ", ".join(f"{k}={v}" for k, v in g.model_dump().items() if k != "builder")
-    table.add_row("units", scene.meta.units)
+    row("units", scene.meta.units)
     if scene.meta.source:
-        table.add_row("source", scene.meta.source)
-    table.add_row("geometry", f"{g.builder} ({params})")
+        row("source", scene.meta.source)
+    row("geometry", f"{g.builder} ({params})")
     divisions = " x ".join(f"{v} {k}" for k, v in scene.mesh.divisions.items())
-    table.add_row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}), "
+    row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}), "
                           f"{built.n_nodes} nodes, {5 * built.n_nodes} DOFs")
     m = scene.material
     params = ", ".join(f"{k}={v}" for k, v in m.model_dump().items() if k not in ("model", "axes"))
-    table.add_row("material", f"{m.model} ({params})")
+    row("material", f"{m.model} ({params})")
     s = scene.section
     strain = f"technique {s.technique}" if s.technique else "small strain"
-    table.add_row("section", f"thickness {s.thickness}, {s.points_through_thickness} points through "
+    row("section", f"thickness {s.thickness}, {s.points_through_thickness} points through "
                              f"it, {strain}, {s.formulation} formulation"
                              + (", plane strain" if s.plane_strain else ""))
     for bc in scene.boundary:
-        table.add_row("boundary", f"{bc.type} on '{bc.set}'")
+        row("boundary", f"{bc.type} on '{bc.set}'")
     for load in scene.load:
         curve = f" x curve '{load.curve}'" if load.curve else ""
-        table.add_row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
+        row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
     for contact in scene.contact:
-        table.add_row("contact", f"{contact.summary} ({len(built.sets[contact.set].nodes)} nodes)")
+        row("contact", f"{contact.summary} ({len(built.sets[contact.set].nodes)} nodes)")
     sv = scene.solver
     if sv.method == "static":
         st = sv.static
         steps = ("arc-length steps along the path (the load found with the shape) until the clock passes"
                  if st.control == "arc_length" else f"{st.newton} Newton-Raphson load steps to")
-        table.add_row("solver", f"static: {steps} t = {sv.end_time}, {st.increments} "
+        row("solver", f"static: {steps} t = {sv.end_time}, {st.increments} "
                                 f"first, at most {st.max_iterations} iterations each, tolerances force "
                                 f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")
-        table.add_row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
+        row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
                               f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
     else:
         if sv.preload is not None:
-            table.add_row("preload", f"static load steps to t = {sv.preload} ({sv.static.increments} first), "
+            row("preload", f"static load steps to t = {sv.preload} ({sv.static.increments} first), "
                                      "then the explicit run from rest in that equilibrium")
-        table.add_row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
+        row("solver", f"to t = {sv.end_time}, dt = dt_crit / {sv.dt_safety_factor} "
                                 f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
                                 + (f", damping {sv.damping}/s" if sv.damping else ""))
-        table.add_row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
+        row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
                                    f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
-        table.add_row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
+        row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
                               f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
                               f"{size_text(outlook['bytes'])} of memory")
     for ref in scene.reference:
         tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
-        table.add_row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "
+        row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "
                                    f"({ref.measure} of probe '{ref.probe}'; {ref.source})")
-    table.add_row("uses", ", ".join(needs.used()) or "linear small-strain shell only")
-    table.add_row("leaves out", ", ".join(needs.left_out()))
+    row("uses", ", ".join(needs.used()) or "linear small-strain shell only")
+    row("leaves out", ", ".join(needs.left_out()))
     return table
 
 

@@ -44,7 +44,15 @@ def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
 
 def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
     """PNGs of every probe's history (``<probe>.png``) and of the energies
-    (``energy.png``) in ``out_dir`` (default ``folder/plots``). Returns the files written."""
+    (``energy.png``) in ``out_dir`` (default ``folder/plots``). Returns the files written.
+    Text from the deck is drawn as written: a '$' in a title is not TeX to parse."""
+    from matplotlib import rc_context
+
+    with rc_context({"text.parse_math": False}):
+        return _plot_run(folder, out_dir, size)
+
+
+def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> list[Path]:
     from matplotlib.figure import Figure
 
     deck, history = _read(folder)

@@ -102,6 +102,8 @@ def edge_forces(xe, de, he, outward, pressure, fe):
 def add_forces(t, model, shape, loads, f, g):
     """f (n, 3) += the edge pressures' forces at time t on the current ``shape``
     (:func:`edge_forces`); they act on the mid-surface, so g takes nothing."""
+    if loads.edges.shape[0] == 0:
+        return  # no edge: nothing allocated in the time loop
     xe, de, he, fe = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty((3, 3))
     for m in range(loads.edges.shape[0]):
         pressure = loads.value[m] * factor(model.curves, loads.curve[m], t)

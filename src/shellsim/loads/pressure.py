@@ -124,6 +124,8 @@ def add_face_forces(rule, conn, curves, t, shape, loads, f, g):
     (n, 3) (:func:`face_forces`). rule: the element's :class:`~shellsim.bundles.Rule`;
     conn (ne, 9); curves: :class:`~shellsim.bundles.Curves`; shape: the current
     :class:`~shellsim.bundles.Shape`."""
+    if loads.elements.shape[0] == 0:
+        return  # no face: nothing allocated in the time loop
     xe, de, he = np.empty((9, 3)), np.empty((9, 3)), np.empty(9)
     fe, ge = np.empty((9, 3)), np.empty((9, 3))
     pressure = np.empty(loads.values.shape[1])

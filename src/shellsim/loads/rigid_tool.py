@@ -193,10 +193,11 @@ def _distance(loads, m, centre, y, normal):
 
 
 @njit(cache=True)
-def _node_forces(loads, m, centre, x, d, h, f, g):
-    """f, g (3,) = the contact force on item m's node at x, d (3,), h, and its
-    director-conjugate part, from the faces the item tests."""
-    y, normal = np.empty(3), np.empty(3)
+def _node_forces(loads, m, centre, x, d, h, out, scratch):
+    """out = (f, g) (3,): the contact force on item m's node at x, d (3,), h, and its
+    director-conjugate part, from the faces the item tests; scratch = (y, normal) (3,)."""
+    f, g = out
+    y, normal = scratch
     f[:] = 0.0
     g[:] = 0.0
     face = loads.faces[m, 0]
@@ -224,11 +225,13 @@ def _centre(loads, curves, m, t, centre):
 @njit(cache=True)
 def add_forces(t, model, shape, loads, f, g):
     """f, g (n, 3) += the tools' contact forces at time t on the current ``shape``."""
-    centre, fn, gn = np.empty(3), np.empty(3), np.empty(3)
+    if loads.nodes.shape[0] == 0:
+        return  # no tool: nothing allocated in the time loop
+    centre, fn, gn, y, normal = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for m in range(loads.nodes.shape[0]):
         node = loads.nodes[m]
         _centre(loads, model.curves, m, t, centre)
-        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], fn, gn)
+        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], (fn, gn), (y, normal))
         for i in range(3):
             f[node, i] += fn[i]
             g[node, i] += gn[i]
@@ -237,11 +240,11 @@ def add_forces(t, model, shape, loads, f, g):
 @njit(cache=True)
 def item_forces(t, curves, shape, loads, out):
     """out (K, 3): each contact node's force at time t (for the tools' measures)."""
-    centre, gn = np.empty(3), np.empty(3)
+    centre, gn, y, normal = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for m in range(loads.nodes.shape[0]):
         node = loads.nodes[m]
         _centre(loads, curves, m, t, centre)
-        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], out[m], gn)
+        _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], (out[m], gn), (y, normal))
 
 
 @njit(cache=True)
@@ -251,7 +254,7 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
     :mod:`shellsim.element.tangent`), into its diagonal block in the first element
     holding it; a node out of contact adds nothing."""
     body = model.body
-    centre, fn, gn = np.empty(3), np.empty(3), np.empty(3)
+    centre, fn, gn, y, normal = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
     block = np.empty((5, 5))
     for m in range(loads.nodes.shape[0]):
@@ -260,7 +263,7 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
         block[:] = 0.0
         for move in range(10):
             step = moved_node(shape.x[node], shape.d[node], shape.e1[node], move, (step_u, step_r), (xm, dm, e1m))
-            _node_forces(loads, m, centre, xm, dm, shape.h[node], fn, gn)
+            _node_forces(loads, m, centre, xm, dm, shape.h[node], (fn, gn), (y, normal))
             weight = 1.0 / (2.0 * step)
             e2 = cross(dm, e1m)
             column = move // 2

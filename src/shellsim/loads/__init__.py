@@ -53,6 +53,11 @@ _KIND_OF = {table: kind for kind in KINDS for table in kind.TABLES}
 Loads = NamedTuple("Loads", [(kind.__name__.rsplit(".", 1)[1], kind.Bundle) for kind in CARRIERS])
 
 
+def _with(model, hook: str):
+    """(kind, bundle) of every kind of ``model`` that has ``hook`` and loads of its own."""
+    return [(kind, bundle) for kind, bundle in zip(CARRIERS, model.loads)
+            if hasattr(kind, hook) and any(len(field) for field in bundle)]
+
 
 class LoadScene(NamedTuple):
     """What a kind's ``build`` reads: the mesh (:class:`shellsim.mesh.Mesh`), the element's
@@ -100,15 +105,13 @@ def features(tables: list) -> dict[str, bool]:
 def calibrate(model, masses: np.ndarray, rotary: np.ndarray, dt: float) -> None:
     """Set the penalty springs of every kind that has them, in place, from the lumped
     masses and rotary masses (n,) and the structure's critical step ``dt``."""
-    for kind, bundle in zip(CARRIERS, model.loads):
-        if hasattr(kind, "calibrate") and any(len(field) for field in bundle):
-            kind.calibrate(bundle, masses, rotary, model.h0, dt)
+    for kind, bundle in _with(model, "calibrate"):
+        kind.calibrate(bundle, masses, rotary, model.h0, dt)
 
 
 def step_share(model) -> float:
     """The share of the structure's critical step that stays stable with every penalty."""
-    return min((kind.step_share(bundle) for kind, bundle in zip(CARRIERS, model.loads)
-                if hasattr(kind, "step_share")), default=1.0)
+    return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)
 
 
 class ToolForces:
@@ -119,7 +122,7 @@ class ToolForces:
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
         self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)))
-                       for kind, bundle in zip(CARRIERS, model.loads) if hasattr(kind, "item_forces") and len(bundle.tool)]
+                       for kind, bundle in _with(model, "item_forces")]
 
     def _items(self, t: float, shape: Shape):
         for item_forces, bundle, out in self._calls:
@@ -183,8 +186,7 @@ class LoadTangents:
 
     def __init__(self, model):
         self.model = model
-        self._calls = [(TypedCall(kind.add_tangent), bundle) for kind, bundle in zip(CARRIERS, model.loads)
-                       if hasattr(kind, "add_tangent") and any(len(field) for field in bundle)]
+        self._calls = [(TypedCall(kind.add_tangent), bundle) for kind, bundle in _with(model, "add_tangent")]
 
     def __call__(self, t: float, shape: Shape, step_u: float, step_r: float, k: np.ndarray) -> None:
         for add_tangent, bundle in self._calls:

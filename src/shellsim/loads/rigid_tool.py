@@ -157,13 +157,13 @@ def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarr
     touches)."""
     n = loads.nodes
     arm = np.where(loads.faces[:, 0] != 0, 0.5 * h[n], 0.0) ** 2
-    compliance = 1.0 / masses[n] + np.where(rotary[n] > 0.0, arm / np.where(rotary[n] > 0.0, rotary[n], 1.0), 0.0)
-    loads.stiffness[:] = loads.penalty / (dt * dt * compliance)
+    turning = np.divide(arm, rotary[n], out=np.zeros_like(arm), where=rotary[n] > 0.0)  # none where no rotary mass
+    loads.stiffness[:] = loads.penalty / (dt * dt * (1.0 / masses[n] + turning))
 
 
 def step_share(loads: Bundle) -> float:
     """The share of the structure's critical step that stays stable with the springs."""
-    return share_of(loads.penalty.max()) if len(loads.penalty) else 1.0
+    return share_of(loads.penalty.max())
 
 
 def share_of(penalty: float) -> float:

@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..element.sampling import pressure_band, thickness_mean
-from ..element.shape import gauss_rule, shape
+from ..element.shape import gauss_rule, gauss_rule_2d, shape
 from ..materials.laws import LAWS
-from ..mesh import layer_geometry
+from ..mesh import element_normals, layer_geometry
 from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
@@ -76,7 +76,8 @@ class OutputMesh:
     hexahedra (solid), C = ne * 9 * nt for the solid, ne * 9 for the shell; layers (L,):
     thickness coordinates of the corner layers ([0] for the shell); gauss_to_nodes (9, 9):
     the element's nodal values of the biquadratic through its 3 x 3 Gauss values;
-    elements_at_node (n,): how many elements share each node.
+    elements_at_node (n,): how many elements share each node; node_areas (n,): each
+    node's share of the initial mid-surface, int N_a dA.
     """
 
     points: np.ndarray
@@ -85,6 +86,7 @@ class OutputMesh:
     layers: np.ndarray
     gauss_to_nodes: np.ndarray
     elements_at_node: np.ndarray
+    node_areas: np.ndarray
 
     @property
     def solid(self) -> bool:
@@ -118,9 +120,13 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
         local = SUB_QUADS
     cells = (np.arange(ne)[:, None, None] * len(layers) * 16 + local[None]).reshape(-1, local.shape[1])
     points = _corner_points(model.x0, model.d0, model.h0, model.conn, layers)
+    rs, weights = gauss_rule_2d(3)
+    node_areas = np.zeros(model.n_nodes)
+    np.add.at(node_areas, model.conn, (np.linalg.norm(element_normals(model.x0, model.conn, rs), axis=-1) * weights)
+              @ shape(rs))
     return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers,
                       gauss_to_nodes=np.linalg.inv(model.rule.N[:len(model.rule.wq)]),
-                      elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes))
+                      elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes), node_areas=node_areas)
 
 
 def von_mises(sigma: np.ndarray) -> np.ndarray:
@@ -141,17 +147,11 @@ def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
-def contact_pressure(sim: Simulation) -> np.ndarray:
+def contact_pressure(sim: Simulation, mesh: OutputMesh) -> np.ndarray:
     """(n,) the contact tools' force on each node over the node's share of the initial
-    mid-surface, int N_a dA: the pressure the tools put on the shell."""
-    model, state, rule = sim.model, sim.state, sim.model.rule
-    nq = len(rule.wq)
-    jac = layer_geometry(model.x0, model.d0, model.h0, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], 0.0)[1]
-    area = np.linalg.norm(np.cross(jac[..., 0], jac[..., 1]), axis=-1) * rule.wq  # (ne, nq)
-    shares = np.zeros(model.n_nodes)
-    np.add.at(shares, model.conn, area @ rule.N[:nq])
-    forces = ToolForces(model, []).at_nodes(state.t, state.fields.shape)
-    return np.linalg.norm(forces, axis=1) / shares
+    mid-surface (``mesh.node_areas``): the pressure the tools put on the shell."""
+    forces = ToolForces(sim.model, []).at_nodes(sim.state.t, sim.state.fields.shape)
+    return np.linalg.norm(forces, axis=1) / mesh.node_areas
 
 
 def fibre_directions(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
@@ -213,7 +213,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
     if CONTACT_PRESSURE in fields:
-        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim), model.conn, len(mesh.layers))
+        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim, mesh), model.conn, len(mesh.layers))
     if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
         for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),

@@ -71,7 +71,7 @@ class VtuSeries:
         root = ET.Element("VTKFile", type="Collection", version="0.1")
         collection = ET.SubElement(root, "Collection")
         for time, file in self.entries:
-            ET.SubElement(collection, "DataSet", timestep=repr(float(time)), part="0", file=file)
+            ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
         write_atomically(self.path, ET.tostring(root, xml_declaration=True))
 
     def close(self) -> None:

@@ -148,12 +148,13 @@ def read_table(path: Path) -> tuple[list[float], list[float]]:
         text = line.split("#")[0].strip()
         if not text:
             continue
-        row = _numbers(text, separator or _separator(text))
+        row_separator = separator or _separator(text)
+        row = _numbers(text, row_separator)
         if row is None:
             if not t:
                 continue  # a header
             raise ValueError(f"file '{path}' line {number}: expected a time and a value, found '{line.strip()}'")
-        separator = separator or _separator(text)
+        separator = row_separator
         if not all(np.isfinite(row)):
             raise ValueError(f"file '{path}' line {number}: expected finite numbers, found '{line.strip()}'")
         if t and row[0] <= t[-1]:

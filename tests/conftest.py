@@ -60,6 +60,21 @@ def prepared(deck):
     return prepare(deck, mesh, build_model(deck, mesh))
 
 
+def initial_external_forces(model):
+    """(f, g) (n, 3): the external forces of ``model`` at t = 0 on its initial shape, and
+    their director-conjugate part (which external_forces turns into rotational forces)."""
+    import numpy as np
+
+    from shellsim.bundles import Shape
+    from shellsim.loads import external_forces
+
+    n = model.n_nodes
+    f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
+    shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+    external_forces(0.0, model, shape, f, fr, g)
+    return f, g
+
+
 def run_deck(deck):
     """``deck`` run to its end time (or solved statically over it)."""
     from shellsim.execute import solve

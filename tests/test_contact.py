@@ -8,15 +8,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
 from shellsim.errors import DeckError
 from shellsim.geometry import build_mesh
-from shellsim.loads import calibrate, external_forces, step_share
+from shellsim.loads import calibrate, step_share
 from shellsim.model import build_model
 from shellsim.solver.explicit import EXTERNAL, INTERNAL, KINETIC
 
-from .conftest import deck_text, run_deck
+from .conftest import deck_text, initial_external_forces, run_deck
 
 PLATE = 'builder = "rectangle"\nlength = 1.0\nwidth = 1.0'
 
@@ -30,12 +29,8 @@ def tool_forces(tool: str, lift: float = 0.0, thickness: float = 0.02):
     mesh = build_mesh(deck)
     mesh.x[:, 2] += lift
     model = build_model(deck, mesh)
-    n = model.n_nodes
-    calibrate(model, np.ones(n), np.ones(n), 1.0)
-    f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
-    # g keeps the director-conjugate forces external_forces turns into fr
-    external_forces(0.0, model, Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy()),
-                    f, fr, g)
+    calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
+    f, g = initial_external_forces(model)
     return f, g, model.x0, model
 
 

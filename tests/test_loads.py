@@ -10,15 +10,13 @@ import numpy as np
 import pytest
 
 from shellsim import loads
-from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
 from shellsim.errors import MeshError
 from shellsim.geometry import build_mesh
-from shellsim.loads import external_forces
 from shellsim.model import build_model
 from shellsim.output.mesh_files import write_mesh_vtu
 
-from .conftest import deck_text, run_deck
+from .conftest import deck_text, initial_external_forces, run_deck
 
 LENGTH, WIDTH = 2.0, 1.0
 
@@ -46,11 +44,7 @@ def forces(text: str) -> tuple[np.ndarray, object]:
     """External forces (n, 3) at t = 0 on the initial shape of the deck ``text``, and its model."""
     deck = parse_deck(text)
     model = build_model(deck, build_mesh(deck))
-    n = model.n_nodes
-    f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
-    shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
-    external_forces(0.0, model, shape, f, fr, g)
-    return f, model
+    return initial_external_forces(model)[0], model
 
 
 def mapped(path, value=1.0, field="wall_pressure") -> str:

@@ -1,7 +1,8 @@
 """Speed, measured: every constitutive path on the Scordelis-Lo 16 x 16 mesh on one thread
 and on every core (microseconds per element per step; GFLOP/s from the operation count
-below, against a one-thread matrix product), and the peer-comparison plate
-(decks/bench/plate_step.toml) on a ladder of meshes (error of the first peak, wall time).
+below, against a one-thread matrix product), the peer-comparison plate
+(decks/bench/plate_step.toml) on a ladder of meshes (error of the first peak, wall time),
+and the cost of contact between shells on two stacked plates whose every node touches.
 Nothing here asserts a time; it reports."""
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 import time
 import tomllib
 from pathlib import Path
@@ -18,7 +20,10 @@ import numpy as np
 
 from .deck import deck_from_data, parse_deck
 from .geometry import build_mesh
+from .loads import calibrate
+from .mesh import Mesh, NamedSet
 from .model import build_model
+from .output.mesh_files import write_mesh_vtu
 from .execute import built_run
 from .solver.run import integrate
 from .solver.simulation import Simulation
@@ -148,4 +153,63 @@ def plate_ladder(divisions=(2, 4, 8)) -> list[dict]:
             "us_per_element_step": 1e6 * run.wall_time / (run.sim.state.steps * run.mesh.n_elements),
             "startup_s": run.startup,
         })
+    return rows
+
+
+#: The stacked plates' deck (its geometry to add): linear elastic, thickness 0.01.
+PLATES = """
+[meta]
+title = "two stacked plates"
+[material]
+model = "linear_elastic"
+E = 1000.0
+nu = 0.3
+density = 1.0
+[section]
+thickness = 0.01
+[solver]
+end_time = 1.0
+"""
+
+
+def stacked_plates(path: Path, lower: int, upper: int, lift: float = 0.0, thickness: float = 0.01) -> Path:
+    """A mesh file of two unit plates: ``lower`` x ``lower`` elements at z = 0 and ``upper``
+    x ``upper`` at z = thickness + lift (their faces touching at lift 0), as surface sets
+    'lower' and 'upper' beside the builder's sets of the lower one (x0, y1, ...)."""
+    def plate(n: int, z: float) -> Mesh:
+        deck = parse_deck(PLATES + '[geometry]\nbuilder = "rectangle"\nlength = 1.0\nwidth = 1.0\n'
+                                   f'[mesh]\ndivisions = {{ length = {n}, width = {n} }}\n')
+        mesh = build_mesh(deck)
+        mesh.x[:, 2] += z
+        return mesh
+
+    a, b = plate(lower, 0.0), plate(upper, thickness + lift)
+    sets = dict(a.sets) | {"lower": NamedSet("surface", np.arange(a.n_nodes), elements=np.arange(a.n_elements)),
+                           "upper": NamedSet("surface", a.n_nodes + np.arange(b.n_nodes),
+                                             elements=a.n_elements + np.arange(b.n_elements))}
+    write_mesh_vtu(Mesh(x=np.vstack([a.x, b.x]), conn=np.vstack([a.conn, b.conn + a.n_nodes]),
+                        director=np.vstack([a.director, b.director]),
+                        thickness=np.full(a.n_nodes + b.n_nodes, thickness), sets=sets), path)
+    return path
+
+
+def contact_cost(divisions: int = 70, steps: int = 50) -> list[dict]:
+    """Microseconds per element-step of the full time step on two stacked plates of
+    ``divisions`` x ``divisions`` elements each (2 divisions^2 elements), their faces
+    touching so that every node is in contact, without contact and with self-contact of
+    both plates as one set (the search over every face, node against face both ways):
+    the share of the step that contact takes."""
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        path = stacked_plates(Path(folder) / "plates.vtu", divisions, divisions)
+        touching = '[[contact]]\ntype = "shells"\nname = "touching"\n'
+        for label, contact in (("without contact", ""), ("self-contact of both plates", touching)):
+            deck = parse_deck(PLATES + f'[geometry]\nbuilder = "file"\npath = "{path.as_posix()}"\n' + contact)
+            model = build_model(deck, build_mesh(deck))
+            sim = Simulation(model)
+            if contact:
+                calibrate(model, sim.state.mt, sim.state.mr, sim.critical_time_step())
+            rows.append({"scene": label, "elements": model.n_elements, "steps": steps,
+                         "us_per_element_step": _us_per_element_step(sim, steps, 1.25)})
+    rows[1]["contact_share"] = 1.0 - rows[0]["us_per_element_step"] / rows[1]["us_per_element_step"]
     return rows

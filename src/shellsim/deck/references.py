@@ -78,8 +78,9 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
         need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))
     for key in ("load", "contact"):
         for i, table in enumerate(getattr(deck, key)):
-            need_set(f"{key}[{i}].set", table.set, table.SET_KINDS)
-            need_curve(f"{key}[{i}].curve", table.curve)
+            for name_key, name in table.named_sets.items():
+                need_set(f"{key}[{i}].{name_key}", name, table.SET_KINDS)
+            need_curve(f"{key}[{i}].curve", getattr(table, "curve", None))
     factors = list(load_factor_columns(deck))
     columns = factors + [p.name for p in deck.output.probe]
     for i, contact in enumerate(deck.contact):

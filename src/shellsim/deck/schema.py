@@ -495,7 +495,7 @@ class Deck(Section):
         if self.output.mirror and not any(b.type == "symmetry" for b in self.boundary):
             problems.append("output.mirror: the deck has no symmetry boundary to mirror across")
         if "contact_pressure" in self.output.fields and not self.contact:
-            problems.append("output.fields: 'contact_pressure' is the pressure of the [[contact]] tools, and the "
+            problems.append("output.fields: 'contact_pressure' is the pressure of the [[contact]] tables, and the "
                             "deck has none")
         if "fibres" in self.output.fields and not self.material.ANISOTROPIC:
             problems.append(f"output.fields: 'fibres' draws a fibre-reinforced law's fibres, and material.model = "

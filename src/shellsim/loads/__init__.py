@@ -18,9 +18,15 @@ and, when it has kernels of its own,
   depend on the shape: less their derivative, into the elements' blocks k (ne, 45, 45);
 - where it is a penalty (contact): ``calibrate(bundle, masses, rotary, h, dt)``, its
   springs from the masses and the structure's critical step when the run starts,
-  ``step_share(bundle)``, the share of that step it leaves stable, and compiled
-  ``item_forces(t, curves, shape, bundle, out)`` with a ``tool`` field, the force each
-  of its tables takes (history columns by the tables' names).
+  ``step_share(bundle)``, the share of that step it leaves stable, compiled
+  ``item_forces(t, model, shape, bundle, out)`` with a ``tool`` field, the force on each
+  of its contact nodes, and ``FORCE_TOTAL``, how a table's history column totals them
+  (``resultant``: the magnitude of their sum, the force on a tool; ``magnitudes``: the
+  sum of their magnitudes, what two sides of the shell press on each other with);
+- where its forces couple nodes that share no element (contact between shells):
+  compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
+  of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
+  returning how many), for the static tangent.
 Adding a kind is writing its module and adding it to :data:`KINDS`.
 """
 
@@ -35,10 +41,10 @@ from ..bundles import Body, Curves, Rule, Shape
 from ..compiled_call import TypedCall
 from ..element.frames import to_rotational
 from ..errors import MeshError
-from . import edge_pressure, mapped_pressure, nodal, pressure, rigid_tool
+from . import edge_pressure, mapped_pressure, nodal, pressure, rigid_tool, shell_contact
 
 #: The kinds, in the order their forces are added.
-KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool)
+KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool, shell_contact)
 
 #: The kinds with kernels of their own: the fields of :data:`Loads`.
 CARRIERS = tuple(kind for kind in KINDS if hasattr(kind, "Bundle"))
@@ -115,31 +121,36 @@ def step_share(model) -> float:
 
 
 class ToolForces:
-    """The contact tools' forces from the kinds' compiled ``item_forces``: the magnitude of
-    the total each contact table's tool takes, by the table's ``name`` (history columns),
-    and the force at each node (output fields)."""
+    """The contact tools' forces from the kinds' compiled ``item_forces``: each contact
+    table's total (its kind's ``FORCE_TOTAL``) by the table's ``name`` (history columns),
+    and the contact force at each node (output fields)."""
 
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
-        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)))
-                       for kind, bundle in _with(model, "item_forces")]
-
-    def _items(self, t: float, shape: Shape):
-        for item_forces, bundle, out in self._calls:
-            item_forces(float(t), self.model.curves, shape, bundle, out)
-            yield bundle, out
+        self._kinds = _with(model, "item_forces")
+        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)), kind.FORCE_TOTAL)
+                       for kind, bundle in self._kinds]
 
     def __call__(self, t: float, shape: Shape) -> dict[str, float]:
         totals = np.zeros((len(self.names), 3))
-        for bundle, out in self._items(t, shape):
-            np.add.at(totals, bundle.tool, out)
-        return {name: float(np.linalg.norm(total)) for name, total in zip(self.names, totals)}
+        magnitudes = np.zeros(len(self.names))
+        resultant = np.zeros(len(self.names), dtype=bool)
+        for item_forces, bundle, out, total in self._calls:
+            item_forces(float(t), self.model, shape, bundle, out)
+            if total == "resultant":
+                np.add.at(totals, bundle.tool, out)
+                resultant[bundle.tool] = True
+            else:
+                np.add.at(magnitudes, bundle.tool, np.linalg.norm(out, axis=1))
+        magnitudes[resultant] = np.linalg.norm(totals[resultant], axis=1)
+        return {name: float(total) for name, total in zip(self.names, magnitudes)}
 
     def at_nodes(self, t: float, shape: Shape) -> np.ndarray:
-        """(n, 3) the contact force on each node at time t."""
-        forces = np.zeros((self.model.n_nodes, 3))
-        for bundle, out in self._items(t, shape):
-            np.add.at(forces, bundle.nodes, out)
+        """(n, 3) the contact force on each node at time t: every contact kind's forces,
+        a face's share of what its contact nodes take included."""
+        forces, g = np.zeros((self.model.n_nodes, 3)), np.zeros((self.model.n_nodes, 3))
+        for kind, bundle in self._kinds:
+            TypedCall(kind.add_forces)(float(t), self.model, shape, bundle, forces, g)
         return forces
 
 
@@ -187,7 +198,21 @@ class LoadTangents:
     def __init__(self, model):
         self.model = model
         self._calls = [(TypedCall(kind.add_tangent), bundle) for kind, bundle in _with(model, "add_tangent")]
+        self._couplings = [(TypedCall(kind.couplings), bundle) for kind, bundle in _with(model, "couplings")]
 
     def __call__(self, t: float, shape: Shape, step_u: float, step_r: float, k: np.ndarray) -> None:
         for add_tangent, bundle in self._calls:
             add_tangent(float(t), self.model, shape, bundle, step_u, step_r, k)
+
+    def couplings(self, t: float, shape: Shape, step_u: float) -> tuple[np.ndarray, np.ndarray]:
+        """The derivative of the forces that couple nodes sharing no element: nodes (P, 10)
+        and blocks (P, 30, 30) d(force)/d(translation) of each group of ten nodes, global
+        axes (translations of step ``step_u`` differenced)."""
+        nodes, blocks = [np.zeros((0, 10), dtype=np.int64)], [np.zeros((0, 30, 30))]
+        for couplings, bundle in self._couplings:
+            n = len(bundle.nodes)
+            some, their = np.zeros((n, 10), dtype=np.int64), np.zeros((n, 30, 30))
+            count = couplings(float(t), self.model, shape, bundle, step_u, some, their)
+            nodes.append(some[:count])
+            blocks.append(their[:count])
+        return np.concatenate(nodes), np.concatenate(blocks)

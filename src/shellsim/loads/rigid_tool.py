@@ -98,6 +98,9 @@ class RigidTool(LoadTable):
 
 TABLES = (RigidTool,)
 
+#: The history column of this kind is the magnitude of the force's resultant on the tool.
+FORCE_TOTAL = "resultant"
+
 
 class Bundle(NamedTuple):
     """The contact nodes (K,) of every rigid tool: nodes; tool (K,) the tool's place among
@@ -238,12 +241,12 @@ def add_forces(t, model, shape, loads, f, g):
 
 
 @njit(cache=True)
-def item_forces(t, curves, shape, loads, out):
+def item_forces(t, model, shape, loads, out):
     """out (K, 3): each contact node's force at time t (for the tools' measures)."""
     centre, gn, y, normal = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for m in range(loads.nodes.shape[0]):
         node = loads.nodes[m]
-        _centre(loads, curves, m, t, centre)
+        _centre(loads, model.curves, m, t, centre)
         _node_forces(loads, m, centre, shape.x[node], shape.d[node], shape.h[node], (out[m], gn), (y, normal))
 
 

@@ -24,6 +24,11 @@ class LoadTable(Section):
     QUANTITY: ClassVar[str] = "load"
 
     @property
+    def named_sets(self) -> dict[str, str]:
+        """The sets the table names, by key (:mod:`shellsim.deck.references` checks them)."""
+        return {"set": self.set}
+
+    @property
     def feature(self) -> str:
         """The plan's feature this load uses."""
         return self.FEATURES[0]

@@ -149,4 +149,22 @@ class Equilibrium:
                           optimize=True).reshape(k.shape)
         indices, indptr, nnz = self._csc
         data = np.bincount(self._slot, weights=k.ravel()[self._entries], minlength=nnz)
-        return sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
+        tangent = sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
+        coupled = self._coupled()
+        return tangent if coupled is None else (tangent - coupled).tocsc()
+
+    def _coupled(self) -> sp.coo_matrix | None:
+        """The derivative of the forces that couple nodes sharing no element (contact
+        between shells) over the unknowns, in the nodes' frames; None where there is none."""
+        u, s = self.unknowns, self.sim.state
+        nodes, blocks = self._load_tangents.couplings(self._t, s.fields.shape, self.step_u)
+        if not len(nodes):
+            return None
+        frames = u.frames[nodes]  # (P, 10, 3, 3): node translations' directions as columns
+        blocks = np.einsum("paij,paibk,pbkl->pajbl", frames, blocks.reshape(-1, 10, 3, 10, 3), frames,
+                           optimize=True)
+        dofs = u.index[nodes][:, :, :3].reshape(len(nodes), 30)
+        rows = np.broadcast_to(dofs[:, :, None], (len(nodes), 30, 30)).ravel()
+        cols = np.broadcast_to(dofs[:, None, :], (len(nodes), 30, 30)).ravel()
+        used = (rows >= 0) & (rows < u.n_free) & (cols >= 0)
+        return sp.coo_matrix((blocks.ravel()[used], (rows[used], cols[used])), shape=(u.n_free, u.size))

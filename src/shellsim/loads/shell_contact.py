@@ -1,0 +1,407 @@
+"""Contact between shells: a surface set that folds onto itself (self-contact) or meets
+another set, by penalty, node against face both ways (the search is
+:mod:`shellsim.loads.contact_search`).
+
+The shell's faces are its mid-surface offset by half the fibre length on each side (the
+shell thickness offset of LS-DYNA's contacts): a node y of one side and the nearest point
+p of a face of the other are in contact when their distance is less than
+``offset`` (h_y + h_p) / 2, h the current fibre lengths (h_p interpolated on the face).
+The gap g = |y - p| - offset (h_y + h_p) / 2 is then negative and the node is pushed
+out along n = (y - p) / |y - p| by F = -k g n, the face's nine nodes back by N_a(p) F
+(the face's shape functions where p is). Both sides are tested: each node of the set
+against the faces of the other, and each node of the other against the faces of the set,
+so neither side's nodes pass through; a node takes the nearest face it penetrates, never
+one that holds it, nor one it overlapped in the initial shape (neighbours of a thick
+shell, or two sets meshed overlapping; found once, when the model is built), as
+LS-DYNA's ``IGNORE`` does. The forces act at
+the mid-surface, on the translations only. Frictionless.
+
+The penalty is the soft constraint of explicit codes: a spring between the node (mass
+m_y) and the face point (the face's masses m_a weighted by N_a^2) of
+k = s / (dt_c^2 (1/m_y + sum_a N_a^2 / m_a)) raises the highest frequency squared by
+at most s / dt_c^2 per pass; with both passes in parallel the critical step is taken as
+dt_c / sqrt(1 + s / 2). The springs' scale is fixed when the run starts
+(:func:`calibrate`), so the forces are conservative but for the nearest point's slide
+along the face.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar, Literal, NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from ..errors import MeshError
+from ..table_types import Name, Positive
+from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
+from .table import LoadTable
+
+
+class ShellContact(LoadTable):
+    """Contact of the faces of the surface set ``set`` with those of ``against`` (leaflet on
+    leaflet), or with its own (no ``against``: self-contact, a strip rolling over itself).
+    ``offset``: the share of the half thicknesses kept between mid-surfaces (1: the faces
+    touch). ``penalty``: the soft constraint's scale s (the critical step falls by the
+    factor 1 / sqrt(1 + s / 2)). ``name``: the history column of the contact force (the
+    sum of the contact forces' magnitudes, both ways)."""
+
+    type: Literal["shells"]
+    name: Name
+    set: Name = "all"
+    against: Name | None = None
+    offset: Positive = 1.0
+    penalty: Positive = 0.1
+    DECK_KEY: ClassVar[str] = "contact"
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
+    FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
+
+    @property
+    def named_sets(self) -> dict[str, str]:
+        """The sets the table names, by key."""
+        return {"set": self.set} | ({"against": self.against} if self.against else {})
+
+    @property
+    def summary(self) -> str:
+        """One line for ``shellsim check``."""
+        other = f"'{self.against}'" if self.against else "itself"
+        return (f"'{self.name}': shell faces of '{self.set}' against {other}, both ways, {self.offset:g} x the half "
+                f"thicknesses apart; penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}")
+
+
+TABLES = (ShellContact,)
+
+#: The contact nodes are searched in this many chunks shared among the threads (a count
+#: the compiled code may not read from the threading layer and still be cached).
+CHUNKS = 64
+
+#: The most faces a node may overlap in the initial shape (those it never meets).
+IGNORED = 32
+
+#: The penalty's smoothing width as a share of the offset (h_y + h_p) / 2: the push
+#: starts this far before the faces touch (and an overlap of the initial shape within it
+#: is none).
+TOUCHING = 1e-3
+
+#: The history column of this kind is the sum of its forces' magnitudes.
+FORCE_TOTAL = "magnitudes"
+
+
+class Bundle(NamedTuple):
+    """The contact nodes (K,) and faces (F,) of every shell contact.
+
+    nodes (K,): each contact node; tool (K,): its table's place among the deck's
+    contacts; group (K,): the faces it is tested against (those of the same group);
+    offset, penalty (K,): the table's; spring (K,): s / dt_c^2 and inverse_mass (K,):
+    1/m (0 until :func:`calibrate`); ignored (K, :data:`IGNORED`): the elements whose
+    faces the node overlaps in the initial shape (-1 after the last). faces (F, 9): each
+    face's nodes; face_elements (F,) their elements; face_group (F,);
+    face_inverse_mass (F, 9) (0 until :func:`calibrate`). Scratch: touches (K,) each
+    contact node's face row (-1: none) and touch_forces (K, 10, 3) the forces on it and
+    the face's nodes; of the search, reach (F,), boxes (F, 6), start (2 F + 1 per table,),
+    entries (8 F,)."""
+
+    nodes: np.ndarray
+    tool: np.ndarray
+    group: np.ndarray
+    offset: np.ndarray
+    penalty: np.ndarray
+    spring: np.ndarray
+    inverse_mass: np.ndarray
+    ignored: np.ndarray
+    faces: np.ndarray
+    face_elements: np.ndarray
+    face_group: np.ndarray
+    face_inverse_mass: np.ndarray
+    touches: np.ndarray
+    touch_forces: np.ndarray
+    reach: np.ndarray
+    boxes: np.ndarray
+    start: np.ndarray
+    entries: np.ndarray
+
+
+def empty(scene) -> Bundle:
+    """No shell contact."""
+    return _passes([], scene.mesh.conn, place=0, table=ShellContact(type="shells", name="none"))
+
+
+def build(table: ShellContact, scene) -> Bundle:
+    """One table's contact: the nodes of its set against the faces of the other, and (a
+    pair) the other's nodes against the set's faces; each node's faces it overlaps in
+    the initial shape found once."""
+    sets = scene.mesh.sets
+    mine = sets[table.set]
+    if table.against is None:
+        passes = [(mine.nodes, mine.elements)]
+    else:
+        theirs = sets[table.against]
+        passes = [(mine.nodes, theirs.elements), (theirs.nodes, mine.elements)]
+    loads = _passes(passes, scene.mesh.conn, place=scene.place, table=table)
+    crowded = _initial_overlaps(scene.initial, loads)
+    if crowded >= 0:
+        raise MeshError(f"node {loads.nodes[crowded]} overlaps more than {IGNORED} faces in the initial shape: the "
+                        "shell is much thicker than its elements there; give a smaller offset or a coarser mesh")
+    return loads
+
+
+def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> Bundle:
+    """A :class:`Bundle` of one table's passes, each (nodes (k,), elements (f,)) whose faces
+    the nodes meet, group 2 place + the pass."""
+    def joined(parts, dtype=np.int64):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
+
+    nodes = joined([n for n, _ in passes])
+    elements = joined([e for _, e in passes])
+    k, f = len(nodes), len(elements)
+    return Bundle(
+        nodes=nodes, tool=np.full(k, place, dtype=np.int64),
+        group=joined([np.full(len(n), 2 * place + i) for i, (n, _) in enumerate(passes)]),
+        offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), spring=np.zeros(k),
+        inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64),
+        faces=conn[elements].astype(np.int64).reshape(-1, 9), face_elements=elements,
+        face_group=joined([np.full(len(e), 2 * place + i) for i, (_, e) in enumerate(passes)]),
+        face_inverse_mass=np.zeros((f, 9)), touches=np.full(k, -1, dtype=np.int64),
+        touch_forces=np.zeros((k, 10, 3)), reach=np.zeros(f), boxes=np.zeros((f, 6)),
+        start=np.zeros(2 * f + 1 if f else 0, dtype=np.int64), entries=np.zeros(8 * f, dtype=np.int64))
+
+
+def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarray, dt: float) -> None:
+    """Set the springs' scale s / dt^2 and the inverse masses (n,) of the contact nodes
+    and the faces' nodes, in place, from the structure's critical step dt."""
+    loads.spring[:] = loads.penalty / (dt * dt)
+    loads.inverse_mass[:] = 1.0 / masses[loads.nodes]
+    loads.face_inverse_mass[:] = 1.0 / masses[loads.faces]
+
+
+def step_share(loads: Bundle) -> float:
+    """The share of the structure's critical step that stays stable with the springs."""
+    return share_of(loads.penalty.max())
+
+
+def share_of(penalty: float) -> float:
+    """The share of the critical step that stays stable with both passes' springs of scale
+    ``penalty``: 1 / sqrt(1 + s / 2)."""
+    return float(1.0 / np.sqrt(1.0 + penalty / 2.0))
+
+
+@njit(cache=True)
+def _work():
+    """The scratch of a contact's geometry: (rs (2,), point (3,), normal (3,)) of the
+    nearest point and :func:`shellsim.loads.contact_search.projection_scratch`."""
+    return (np.empty(2), np.empty(3), np.empty(3)), projection_scratch()
+
+
+@njit(cache=True)
+def _depth(x, h, loads, m, row, work):
+    """How deep contact node m is into face row ``row``, the shape (x (n, 3), h (n,))
+    given: offset (h_y + h_p) / 2 less their distance (-gap), and the width of the
+    penalty's smoothing there (:data:`TOUCHING` of that offset). work = (contact,
+    scratch) of :func:`_work`: the nearest point's (rs (2,), point (3,), normal (3,)) and
+    its shape functions left in scratch[0]."""
+    (rs, point, normal), scratch = work
+    nodes = loads.faces[row]
+    node = loads.nodes[m]
+    distance = nearest_point(x, nodes, x[node], rs, point, normal, scratch)
+    N = scratch[0]
+    thickness = 0.0
+    for a in range(9):
+        thickness += N[a] * h[nodes[a]]
+    reach = 0.5 * loads.offset[m] * (h[node] + thickness)
+    return reach - distance, TOUCHING * reach
+
+
+@njit(cache=True)
+def _holds(nodes, node):
+    """Whether a face's nodes (9,) hold ``node``."""
+    for a in range(9):
+        if nodes[a] == node:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _grid(shape, loads):
+    """The search grid of the faces on the current shape: each face's box grown by the
+    largest reach of a contact (half its own largest and the largest node's fibre
+    length, times the offset, and the smoothing). Returns (width, origin)
+    (:func:`build_grid`)."""
+    h = shape.h
+    deepest = 0.0
+    for m in range(loads.nodes.shape[0]):
+        deepest = max(deepest, loads.offset[m] * h[loads.nodes[m]])
+    for f in range(loads.faces.shape[0]):
+        thickest = 0.0
+        for a in range(9):
+            thickest = max(thickest, h[loads.faces[f, a]])
+        loads.reach[f] = 0.5 * (deepest + thickest) * (1.0 + TOUCHING)
+    return build_grid(shape.x, loads.faces, loads.reach, (loads.boxes, loads.start, loads.entries))
+
+
+@njit(cache=True)
+def _candidates(shape, loads, m, grid, work, ignoring):
+    """The face row contact node m is deepest into on ``shape`` (-1: none); ``grid``
+    (width, origin) of :func:`_grid`. Faces that hold the node are passed over, and so
+    are the node's ``ignored`` faces where ``ignoring``. With ``ignoring`` false, the
+    faces it is into by more than the smoothing width are listed in loads.ignored[m]
+    instead (the initial overlaps), and -2 - count returned when more than fit."""
+    width, origin = grid
+    node = loads.nodes[m]
+    y = shape.x[node]
+    first, stop = cell_faces(y, width, origin, loads.start)
+    best, deepest, listed = -1, -np.inf, 0
+    for entry in range(first, stop):
+        row = loads.entries[entry]
+        if loads.face_group[row] != loads.group[m] or not near_box(y, loads.boxes, row, loads.reach[row]) \
+                or _holds(loads.faces[row], node) or (ignoring and _ignored(loads, m, row)):
+            continue
+        depth, smoothing = _depth(shape.x, shape.h, loads, m, row, work)
+        if depth <= -smoothing:
+            continue
+        if not ignoring:
+            if depth > smoothing:  # more than touching
+                if listed == IGNORED:
+                    return -2 - listed
+                loads.ignored[m, listed] = loads.face_elements[row]
+                listed += 1
+        elif depth > deepest:
+            best, deepest = row, depth
+    return best
+
+
+@njit(cache=True)
+def _ignored(loads, m, row):
+    """Whether contact node m overlapped face row ``row`` in the initial shape."""
+    element = loads.face_elements[row]
+    for k in range(IGNORED):
+        if loads.ignored[m, k] == element:
+            return True
+        if loads.ignored[m, k] < 0:
+            return False
+    return False
+
+
+@njit(cache=True)
+def _touched(shape, loads, m, grid, work):
+    """The face row contact node m is deepest into on the current shape (-1: none), of
+    the faces that neither hold it nor overlapped it in the initial shape."""
+    return _candidates(shape, loads, m, grid, work, True)
+
+
+@njit(cache=True)
+def _initial_overlaps(initial, loads):
+    """Each contact node's faces it overlaps on the ``initial`` shape into loads.ignored.
+    Returns the first contact node that overlaps more than :data:`IGNORED`, or -1."""
+    if loads.nodes.shape[0] == 0:
+        return -1
+    grid = _grid(initial, loads)
+    work = _work()
+    for m in range(loads.nodes.shape[0]):
+        if _candidates(initial, loads, m, grid, work, False) < -1:
+            return m
+    return -1
+
+
+@njit(cache=True)
+def _pair_forces(x, h, loads, m, row, out, work):
+    """out (10, 3): the force on contact node m and on the nine nodes of face row ``row``,
+    the shape (x, h) given: the node pushed out along the normal by k times its depth d
+    (the spring of the module's text), the face's nodes back by N_a times that. Within
+    the smoothing width w of touching the push is k (d + w)^2 / (4 w), so that it and its
+    derivative are continuous (the static tangent stays consistent and a body resting
+    on another has a stiffness before it penetrates); zero below d = -w."""
+    depth, smoothing = _depth(x, h, loads, m, row, work)
+    out[:] = 0.0
+    if depth <= -smoothing or loads.spring[m] == 0.0:  # apart, or the springs not set yet
+        return
+    N = work[1][0]
+    weight = loads.inverse_mass[m]
+    for a in range(9):
+        weight += N[a] * N[a] * loads.face_inverse_mass[row, a]
+    spring = loads.spring[m] / weight
+    push = spring * depth if depth >= smoothing else spring * (depth + smoothing) ** 2 / (4.0 * smoothing)
+    normal = work[0][2]
+    for i in range(3):
+        out[0, i] = push * normal[i]
+        for a in range(9):
+            out[1 + a, i] = -N[a] * push * normal[i]
+
+
+@njit(cache=True, parallel=True)
+def _contact_forces(model, shape, loads):
+    """Each contact node's face on the current shape into loads.touches (K,) (-1: none)
+    and the ten nodes' forces of its contact into loads.touch_forces (K, 10, 3), the
+    nodes shared among the threads (each node's contact is its own)."""
+    grid = _grid(shape, loads)
+    count = loads.nodes.shape[0]
+    chunks = min(count, CHUNKS)
+    for c in prange(chunks):
+        _contact_chunk(c * count // chunks, (c + 1) * count // chunks, shape, loads, grid)
+
+
+@njit(cache=True)
+def _contact_chunk(first, stop, shape, loads, grid):
+    """:func:`_contact_forces` of contact nodes first..stop-1."""
+    work = _work()
+    for m in range(first, stop):
+        row = _touched(shape, loads, m, grid, work)
+        loads.touches[m] = row
+        if row >= 0:
+            _pair_forces(shape.x, shape.h, loads, m, row, loads.touch_forces[m], work)
+        else:
+            loads.touch_forces[m] = 0.0
+
+
+@njit(cache=True)
+def add_forces(t, model, shape, loads, f, g):
+    """f (n, 3) += the contact forces on the current ``shape`` (none on the directors, g)."""
+    if loads.nodes.shape[0] == 0:
+        return
+    _contact_forces(model, shape, loads)
+    for m in range(loads.nodes.shape[0]):
+        row = loads.touches[m]
+        if row < 0:
+            continue
+        for i in range(3):
+            f[loads.nodes[m], i] += loads.touch_forces[m, 0, i]
+            for a in range(9):
+                f[loads.faces[row, a], i] += loads.touch_forces[m, 1 + a, i]
+
+
+@njit(cache=True)
+def item_forces(t, model, shape, loads, out):
+    """out (K, 3): the force on each contact node (for the history)."""
+    _contact_forces(model, shape, loads)
+    out[:] = loads.touch_forces[:, 0]
+
+
+@njit(cache=True)
+def couplings(t, model, shape, loads, step_u, nodes, blocks):
+    """The derivative of each touching pair's forces with respect to its ten nodes'
+    translations (central differences of step ``step_u``; the pair and the fibre lengths
+    held): nodes (K, 10) the node numbers and blocks (K, 30, 30) dF/dx, filled from the
+    top. Returns how many pairs touch."""
+    grid = _grid(shape, loads)
+    work = _work()
+    plus, minus = np.empty((10, 3)), np.empty((10, 3))
+    x = shape.x
+    count = 0
+    for m in range(loads.nodes.shape[0]):
+        row = _touched(shape, loads, m, grid, work)
+        if row < 0:
+            continue
+        nodes[count, 0] = loads.nodes[m]
+        nodes[count, 1:] = loads.faces[row]
+        for j in range(30):
+            node, i = nodes[count, j // 3], j % 3
+            kept = x[node, i]
+            x[node, i] = kept + step_u
+            _pair_forces(x, shape.h, loads, m, row, plus, work)
+            x[node, i] = kept - step_u
+            _pair_forces(x, shape.h, loads, m, row, minus, work)
+            x[node, i] = kept
+            for a in range(10):
+                for k in range(3):
+                    blocks[count, 3 * a + k, j] = (plus[a, k] - minus[a, k]) / (2.0 * step_u)
+        count += 1
+    return count

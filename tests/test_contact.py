@@ -236,3 +236,4 @@ formats = ["vtu"]
 
     rows = list(csv.DictReader((tmp_path / "out" / "history.csv").open()))
     assert float(rows[-1]["floor"]) == pytest.approx(p * 1.0, rel=1e-9)
+    assert float(rows[-1]["floor_area"]) == pytest.approx(1.0, rel=1e-12)  # every node touches: the plate's area

@@ -102,6 +102,8 @@ def test_a_plate_pressed_on_another_with_a_mesh_of_its_own_takes_the_pressure_ev
     pressure = contact_pressure(run.sim, output_mesh(run.model))
     np.testing.assert_allclose(pressure[upper], p, rtol=0.01)
     assert run.history["between"][-1] == pytest.approx(p * 1.0, rel=0.005)
+    # every node of both plates touches: each plate's area, counted once
+    assert run.history["between_area"][-1] == pytest.approx(1.0, rel=1e-12)
     separation = run.sim.state.x[upper, 2] - run.sim.state.x[lower, 2].mean()
     assert np.all(separation < H * (1.0 + 1e-3)) and np.all(separation > H * (1.0 - 1e-3))
 
@@ -141,6 +143,7 @@ component = "z"
     lowest = int(np.argmin(height))
     assert height[lowest] == pytest.approx(-0.02, abs=1e-3)  # it reached the lower plate
     assert max(run.history["between"]) > 0.0 and run.history["between"][-1] == 0.0
+    assert 0.0 < max(run.history["between_area"]) <= 1.0 + 1e-12 and run.history["between_area"][-1] == 0.0
     assert height[lowest:].max() > -0.5 * 0.02  # it bounced
     energies = np.asarray(run.energies)
     balance = energies[:, INTERNAL] + energies[:, KINETIC] - energies[:, EXTERNAL]
@@ -204,6 +207,7 @@ def test_a_strip_rolled_one_and_a_half_turns_keeps_its_turns_one_thickness_apart
 
 @pytest.mark.parametrize(("keys", "expected"), [
     ('against = "nowhere"', "contact[0].against: unknown set 'nowhere'"),
+    ('[[contact]]\ntype = "shells"\nname = "fold_area"', "contact[1].name: 'fold_area' is already a history column"),
     ('against = "x0"', "contact[0].against: set 'x0' is a edge set"),
     ("offset = 0.0", "contact[0].offset"),
 ])

@@ -83,6 +83,15 @@ def element_normals(x: np.ndarray, conn: np.ndarray, rs: np.ndarray) -> np.ndarr
     return np.cross(g[:, :, 0], g[:, :, 1])
 
 
+def node_areas(x: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """(n,) each node's share of the mid-surface through x (n, 3), int N_a dA, by the 3 x 3
+    rule: the area a uniform pressure's consistent load gives the node."""
+    rs, weights = gauss_rule_2d(3)
+    areas = np.zeros(len(x))
+    np.add.at(areas, conn, (np.linalg.norm(element_normals(x, conn, rs), axis=-1) * weights) @ shape(rs))
+    return areas
+
+
 def orient_consistently(x: np.ndarray, conn: np.ndarray, preferred: np.ndarray | None) -> np.ndarray:
     """Connectivity with every element ordered so that neighbours agree on the normal.
 

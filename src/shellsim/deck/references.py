@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 
+from ..loads import measure_names
 from .schema import Deck
 
 
@@ -84,16 +85,17 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
     factors = list(load_factor_columns(deck))
     columns = factors + [p.name for p in deck.output.probe]
     for i, contact in enumerate(deck.contact):
-        if contact.name in columns:
-            problems.append(f"contact[{i}].name: '{contact.name}' is already a history column (a probe's or a "
-                            "curve's load factor); choose another name")
-        columns.append(contact.name)
+        for column in measure_names([contact.name]):
+            if column in columns:
+                problems.append(f"contact[{i}].name: '{column}' is already a history column (a probe's, a curve's "
+                                "load factor or a contact's); choose another name")
+            columns.append(column)
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)
         if probe.name in factors:
             problems.append(f"output.probe[{i}].name: '{probe.name}' is the history's column of a curve's load "
                             "factor; choose another name")
-    probes = [p.name for p in deck.output.probe] + factors + [c.name for c in deck.contact]
+    probes = [p.name for p in deck.output.probe] + factors + measure_names([c.name for c in deck.contact])
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:
             problems.append(

@@ -20,9 +20,11 @@ and, when it has kernels of its own,
   springs from the masses and the structure's critical step when the run starts,
   ``step_share(bundle)``, the share of that step it leaves stable, compiled
   ``item_forces(t, model, shape, bundle, out)`` with a ``tool`` field, the force on each
-  of its contact nodes, and ``FORCE_TOTAL``, how a table's history column totals them
+  of its contact nodes, ``FORCE_TOTAL``, how a table's history column totals them
   (``resultant``: the magnitude of their sum, the force on a tool; ``magnitudes``: the
-  sum of their magnitudes, what two sides of the shell press on each other with);
+  sum of their magnitudes, what two sides of the shell press on each other with), and
+  ``SIDES``, how many of the shell's sides a contact's nodes are on (1: a tool's; 2:
+  both sides of a contact between shells, whose nodes' areas count each contact twice);
 - where its forces couple nodes that share no element (contact between shells):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
@@ -41,6 +43,7 @@ from ..bundles import Body, Curves, Rule, Shape
 from ..compiled_call import TypedCall
 from ..element.frames import to_rotational
 from ..errors import MeshError
+from ..mesh import node_areas
 from . import edge_pressure, mapped_pressure, nodal, pressure, rigid_tool, shell_contact
 
 #: The kinds, in the order their forces are added.
@@ -121,29 +124,34 @@ def step_share(model) -> float:
 
 
 class ToolForces:
-    """The contact tools' forces from the kinds' compiled ``item_forces``: each contact
-    table's total (its kind's ``FORCE_TOTAL``) by the table's ``name`` (history columns),
-    and the contact force at each node (output fields)."""
+    """The contact tables' measures from the kinds' compiled ``item_forces``: each table's
+    force (its kind's ``FORCE_TOTAL``) by the table's ``name`` and its contact area (the
+    initial mid-surface shares of the nodes in contact, over the kind's ``SIDES``) by
+    ``name_area`` (history columns, :func:`measure_names`), and the contact force at each
+    node (output fields)."""
 
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
         self._kinds = _with(model, "item_forces")
-        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)), kind.FORCE_TOTAL)
+        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)), kind)
                        for kind, bundle in self._kinds]
+        self._areas = node_areas(model.x0, model.conn) if self._calls else None
 
     def __call__(self, t: float, shape: Shape) -> dict[str, float]:
         totals = np.zeros((len(self.names), 3))
-        magnitudes = np.zeros(len(self.names))
+        forces, areas = np.zeros(len(self.names)), np.zeros(len(self.names))
         resultant = np.zeros(len(self.names), dtype=bool)
-        for item_forces, bundle, out, total in self._calls:
+        for item_forces, bundle, out, kind in self._calls:
             item_forces(float(t), self.model, shape, bundle, out)
-            if total == "resultant":
+            magnitude = np.linalg.norm(out, axis=1)
+            if kind.FORCE_TOTAL == "resultant":
                 np.add.at(totals, bundle.tool, out)
                 resultant[bundle.tool] = True
             else:
-                np.add.at(magnitudes, bundle.tool, np.linalg.norm(out, axis=1))
-        magnitudes[resultant] = np.linalg.norm(totals[resultant], axis=1)
-        return {name: float(total) for name, total in zip(self.names, magnitudes)}
+                np.add.at(forces, bundle.tool, magnitude)
+            np.add.at(areas, bundle.tool, np.where(magnitude > 0.0, self._areas[bundle.nodes], 0.0) / kind.SIDES)
+        forces[resultant] = np.linalg.norm(totals[resultant], axis=1)
+        return dict(zip(measure_names(self.names), np.column_stack([forces, areas]).ravel().tolist()))
 
     def at_nodes(self, t: float, shape: Shape) -> np.ndarray:
         """(n, 3) the contact force on each node at time t: every contact kind's forces,
@@ -152,6 +160,12 @@ class ToolForces:
         for kind, bundle in self._kinds:
             TypedCall(kind.add_forces)(float(t), self.model, shape, bundle, forces, g)
         return forces
+
+
+def measure_names(names: list[str]) -> list[str]:
+    """The history columns of contact tables of these ``name``s: each name (its force)
+    and name_area (its contact area)."""
+    return [column for name in names for column in (name, f"{name}_area")]
 
 
 def _chained(name: str, position: int = 0):

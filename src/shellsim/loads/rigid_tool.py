@@ -98,8 +98,9 @@ class RigidTool(LoadTable):
 
 TABLES = (RigidTool,)
 
-#: The history column of this kind is the magnitude of the force's resultant on the tool.
-FORCE_TOTAL = "resultant"
+#: The history column of this kind is the magnitude of the force's resultant on the tool;
+#: its contacts are on one side of the shell.
+FORCE_TOTAL, SIDES = "resultant", 1
 
 
 class Bundle(NamedTuple):

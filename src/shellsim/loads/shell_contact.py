@@ -83,8 +83,9 @@ IGNORED = 32
 #: is none).
 TOUCHING = 1e-3
 
-#: The history column of this kind is the sum of its forces' magnitudes.
-FORCE_TOTAL = "magnitudes"
+#: The history column of this kind is the sum of its forces' magnitudes; a contact has
+#: nodes on both sides.
+FORCE_TOTAL, SIDES = "magnitudes", 2
 
 
 class Bundle(NamedTuple):

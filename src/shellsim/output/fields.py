@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..element.sampling import pressure_band, thickness_mean
-from ..element.shape import gauss_rule, gauss_rule_2d, shape
+from ..element.shape import gauss_rule, shape
 from ..materials.laws import LAWS
-from ..mesh import element_normals, layer_geometry
+from ..mesh import layer_geometry, node_areas
 from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
@@ -120,13 +120,10 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
         local = SUB_QUADS
     cells = (np.arange(ne)[:, None, None] * len(layers) * 16 + local[None]).reshape(-1, local.shape[1])
     points = _corner_points(model.x0, model.d0, model.h0, model.conn, layers)
-    rs, weights = gauss_rule_2d(3)
-    node_areas = np.zeros(model.n_nodes)
-    np.add.at(node_areas, model.conn, (np.linalg.norm(element_normals(model.x0, model.conn, rs), axis=-1) * weights)
-              @ shape(rs))
     return OutputMesh(points, cells, "hexahedron" if solid else "quad", layers,
                       gauss_to_nodes=np.linalg.inv(model.rule.N[:len(model.rule.wq)]),
-                      elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes), node_areas=node_areas)
+                      elements_at_node=np.bincount(model.conn.ravel(), minlength=model.n_nodes),
+                      node_areas=node_areas(model.x0, model.conn))
 
 
 def von_mises(sigma: np.ndarray) -> np.ndarray:

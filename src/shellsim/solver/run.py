@@ -21,7 +21,7 @@ from ..curve_tables import factor
 from ..deck import Deck
 from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
-from ..loads import ToolForces, calibrate, step_share
+from ..loads import ToolForces, calibrate, measure_names, step_share
 from ..mesh import Mesh
 from ..model import Model
 from .probes import Probe, probe_value, resolve_probes
@@ -154,7 +154,8 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
               quality=ElementQuality(mesh))
     run.load_factors = load_factor_columns(deck)
     names = [contact.name for contact in deck.contact]
-    run.history = {p.name: [] for p in probes} | {name: [] for name in run.load_factors} | {n: [] for n in names}
+    run.history = ({p.name: [] for p in probes} | {name: [] for name in run.load_factors}
+                   | {column: [] for column in measure_names(names)})
     if names:
         s = run.sim.state
         calibrate(model, s.mt, s.mr, run.sim.critical_time_step())

@@ -37,6 +37,15 @@ thickness = 0.1
 end_time = 1e-3
 [output]
 fields = ["displacement", "cauchy_stress", "pressure_band"]
+[[contact]]
+type = "shells"
+name = "fold"
+[[contact]]
+type = "rigid_tool"
+name = "floor"
+shape = "plane"
+point = [0.0, 0.0, -1.0]
+normal = [0.0, 0.0, 1.0]
 """
 
 

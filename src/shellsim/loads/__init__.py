@@ -132,10 +132,12 @@ class ToolForces:
 
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
-        self._kinds = _with(model, "item_forces")
+        kinds = _with(model, "item_forces")
         self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)), kind)
-                       for kind, bundle in self._kinds]
-        self._areas = node_areas(model.x0, model.conn) if self._calls else None
+                       for kind, bundle in kinds]
+        self._forces = [(TypedCall(kind.add_forces), bundle) for kind, bundle in kinds]
+        # the areas only where there are columns to fill (the output field has its own)
+        self._areas = node_areas(model.x0, model.conn) if self._calls and names else None
 
     def __call__(self, t: float, shape: Shape) -> dict[str, float]:
         totals = np.zeros((len(self.names), 3))
@@ -157,8 +159,8 @@ class ToolForces:
         """(n, 3) the contact force on each node at time t: every contact kind's forces,
         a face's share of what its contact nodes take included."""
         forces, g = np.zeros((self.model.n_nodes, 3)), np.zeros((self.model.n_nodes, 3))
-        for kind, bundle in self._kinds:
-            TypedCall(kind.add_forces)(float(t), self.model, shape, bundle, forces, g)
+        for add_forces, bundle in self._forces:
+            add_forces(float(t), self.model, shape, bundle, forces, g)
         return forces
 
 

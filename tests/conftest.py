@@ -71,7 +71,7 @@ def initial_external_forces(model):
     n = model.n_nodes
     f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
     shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
-    external_forces(0.0, model, shape, f, fr, g)
+    external_forces(0.0, model, shape, np.zeros((n, 3)), np.zeros((n, 2)), f, fr, g)
     return f, g
 
 

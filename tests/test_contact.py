@@ -5,6 +5,8 @@ deck's word on a tool it cannot use."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -237,3 +239,5 @@ formats = ["vtu"]
     rows = list(csv.DictReader((tmp_path / "out" / "history.csv").open()))
     assert float(rows[-1]["floor"]) == pytest.approx(p * 1.0, rel=1e-9)
     assert float(rows[-1]["floor_area"]) == pytest.approx(1.0, rel=1e-12)  # every node touches: the plate's area
+    contact = json.loads((tmp_path / "out" / "summary.json").read_text())["contact"]
+    assert contact["us_per_evaluation"] > 0.0 and "share_of_step" not in contact  # a static solve has no steps

@@ -501,6 +501,10 @@ class Deck(Section):
             problems.append(f"output.fields: 'fibres' draws a fibre-reinforced law's fibres, and material.model = "
                             f"'{self.material.model}' has none")
         problems += proportion_problems(self.geometry, self.section.thickness)
+        if self.solver.method == "static":
+            problems += [f"contact[{i}].friction = {c.friction:g}: friction opposes sliding velocities, and a static "
+                         "solve has none (it is frictionless); give friction = 0, or solver.method = 'explicit'"
+                         for i, c in enumerate(self.contact) if c.friction]
         if self.solver.method == "static" and self.solver.static.control == "arc_length":
             moved = [f"boundary[{i}]" for i, b in enumerate(self.boundary) if b.type == "prescribed" and b.value != 0]
             if moved:

@@ -25,6 +25,9 @@ and, when it has kernels of its own,
   sum of their magnitudes, what two sides of the shell press on each other with), and
   ``SIDES``, how many of the shell's sides a contact's nodes are on (1: a tool's; 2:
   both sides of a contact between shells, whose nodes' areas count each contact twice);
+- where it has friction: compiled ``add_friction(t, model, shape, bundle, f, g, v, w)``,
+  its sliding forces at the velocities v (n, 3), w (n, 2), added after its
+  ``add_forces`` on the same shape (it may read what that left in the bundle);
 - where its forces couple nodes that share no element (contact between shells):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
@@ -34,6 +37,7 @@ Adding a kind is writing its module and adding it to :data:`KINDS`.
 
 from __future__ import annotations
 
+import time
 from typing import Callable, NamedTuple, Union
 
 import numpy as np
@@ -155,6 +159,18 @@ class ToolForces:
         forces[resultant] = np.linalg.norm(totals[resultant], axis=1)
         return dict(zip(measure_names(self.names), np.column_stack([forces, areas]).ravel().tolist()))
 
+    def seconds_per_evaluation(self, t: float, shape: Shape, repeats: int = 5) -> float:
+        """The median wall time [s] of every contact kind's forces at time t on ``shape``
+        (the search included), as a time step evaluates them (``repeats`` times)."""
+        forces, g = np.zeros((self.model.n_nodes, 3)), np.zeros((self.model.n_nodes, 3))
+        times = []
+        for _ in range(repeats):
+            start = time.perf_counter()
+            for add_forces, bundle in self._forces:
+                add_forces(float(t), self.model, shape, bundle, forces, g)
+            times.append(time.perf_counter() - start)
+        return float(np.median(times))
+
     def at_nodes(self, t: float, shape: Shape) -> np.ndarray:
         """(n, 3) the contact force on each node at time t: every contact kind's forces,
         a face's share of what its contact nodes take included."""
@@ -170,38 +186,46 @@ def measure_names(names: list[str]) -> list[str]:
     return [column for name in names for column in (name, f"{name}_area")]
 
 
-def _chained(name: str, position: int = 0):
-    """A compiled f(t, model, shape, f, g) that calls CARRIERS[k].<name>(t, model, shape,
-    model.loads[k], f, g) for every k from ``position`` on, in order. Compiled code cannot
-    call a function held in a value and still be cached, so the chain is built here, one
-    inlined link per kind."""
-    kind_function = getattr(CARRIERS[position], name)
-    if position == len(CARRIERS) - 1:
+def _chained(name: str, positions: tuple[int, ...]):
+    """A compiled chain(t, model, shape, args) that calls CARRIERS[k].<name>(t, model,
+    shape, model.loads[k], *args) for every k of ``positions``, in order (nothing for
+    none). Compiled code cannot call a function held in a value and still be cached, so
+    the chain is built here, one inlined link per kind."""
+    if not positions:
         @njit(inline="always")
-        def last(t, model, shape, f, g):
-            kind_function(t, model, shape, model.loads[position], f, g)
-        return last
-    rest = _chained(name, position + 1)
+        def nothing(t, model, shape, args):
+            pass
+        return nothing
+    position, rest = positions[0], _chained(name, positions[1:])
+    kind_function = getattr(CARRIERS[position], name)
 
     @njit(inline="always")
-    def link(t, model, shape, f, g):
-        kind_function(t, model, shape, model.loads[position], f, g)
-        rest(t, model, shape, f, g)
+    def link(t, model, shape, args):
+        kind_function(t, model, shape, model.loads[position], *args)
+        rest(t, model, shape, args)
     return link
 
 
-_add_every_kind = _chained("add_forces")
+def _every_kind_with(name: str):
+    """:func:`_chained` over every carrying kind that has the hook ``name``."""
+    return _chained(name, tuple(k for k, kind in enumerate(CARRIERS) if hasattr(kind, name)))
+
+
+_add_every_kind = _every_kind_with("add_forces")
+_add_every_friction = _every_kind_with("add_friction")
 
 
 @njit(cache=True)
-def external_forces(t, model, shape, f_ext, fr_ext, g):
+def external_forces(t, model, shape, v, w, f_ext, fr_ext, g):
     """External forces at time t of every load of ``model`` (:class:`shellsim.bundles.Model`)
-    on the current ``shape``: f_ext (n, 3) translational and fr_ext (n, 2) rotational,
-    both overwritten. g (n, 3): scratch for the director-conjugate forces, so that
-    nothing is allocated per step."""
+    on the current ``shape`` moving at the velocities v (n, 3), w (n, 2) (friction's;
+    zeros for none): f_ext (n, 3) translational and fr_ext (n, 2) rotational, both
+    overwritten. g (n, 3): scratch for the director-conjugate forces, so that nothing is
+    allocated per step."""
     f_ext[:] = 0.0
     g[:] = 0.0
-    _add_every_kind(t, model, shape, f_ext, g)
+    _add_every_kind(t, model, shape, (f_ext, g))
+    _add_every_friction(t, model, shape, (f_ext, g, v, w))
     # director-conjugate forces act on the rotational DOFs through the fibre frame
     to_rotational(g, shape.d, shape.e1, fr_ext)
 

@@ -6,7 +6,8 @@ y = x + t h/2 d (t = -1 bottom, +1 top, 0 the mid-surface), against the tool's s
 distance phi(y) (positive on the side the shell belongs to). Where phi < 0 the face point
 is pushed out along the tool's normal n with the force -k phi n, which acts where the
 face is: on the node's translations and, through its lever arm t h/2, on its director
-(as a face pressure does). Frictionless.
+(as a face pressure does). With ``friction`` mu, the face point's velocity relative to
+the tool, tangent to it, is opposed by mu times the push (:func:`add_friction`).
 
 The penalty is the soft constraint of explicit codes: each node's spring is
 k = s / (dt_c^2 (1/m + (h/2)^2 / m_r)), dt_c the structure's critical step, m and m_r the
@@ -15,22 +16,23 @@ node's translational and rotary masses (the face point moves by both), s =
 s / dt_c^2 = (s / 4) omega_max^2, so the critical step is taken as dt_c / sqrt(1 + s / 4)
 (0.988 dt_c for the default s = 0.1): contact never lowers it by more. The springs are
 set once, when the run starts (:func:`calibrate`), so the contact force is conservative:
-its work, counted with the external work, is the spring energy.
+its work, counted with the external work, is the spring energy (and friction's work is
+counted there too).
 """
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal, NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 from numba import njit
 from pydantic import model_validator
 
-from ..curve_tables import factor
+from ..curve_tables import factor, rate
 from ..element.frames import cross
 from ..element.tangent import moved_node
 from ..table_types import Name, Positive, Vec3
-from .table import LoadTable
+from .table import ContactTable
 
 #: Codes of the tools' shapes.
 SHAPES = {"plane": 0, "sphere": 1, "cylinder": 2}
@@ -38,7 +40,7 @@ SHAPES = {"plane": 0, "sphere": 1, "cylinder": 2}
 FACE_RANGES = {"both": (-1, 1), "bottom": (-1, -1), "top": (1, 1), "mid": (0, 0)}
 
 
-class RigidTool(LoadTable):
+class RigidTool(ContactTable):
     """A rigid tool the faces of a surface set may not pass: ``shape = "plane"`` through
     ``point`` with unit ``normal`` pointing to the shell's side; ``"sphere"`` of ``radius``
     centred at ``point``; ``"cylinder"`` of ``radius`` about the line through ``point``
@@ -46,12 +48,11 @@ class RigidTool(LoadTable):
     stent's outside) or ``inside`` it (a vessel in a tube). The tool moves by ``motion *
     curve(t)``. ``faces``: the shell's faces that touch it (``both``, ``bottom``, ``top``
     or the ``mid`` surface). ``penalty``: the soft constraint's scale s (the critical step
-    falls by the factor 1 / sqrt(1 + s / 4)). ``name``: the history column of the force
-    the tool takes (its magnitude)."""
+    falls by the factor 1 / sqrt(1 + s / 4)). ``friction``: Coulomb's mu between the shell
+    and the tool. ``name``: the history column of the force the tool takes (its
+    magnitude)."""
 
     type: Literal["rigid_tool"]
-    name: Name
-    set: Name = "all"
     shape: Literal["plane", "sphere", "cylinder"]
     point: Vec3 = (0.0, 0.0, 0.0)
     normal: Vec3 | None = None
@@ -61,10 +62,6 @@ class RigidTool(LoadTable):
     motion: Vec3 = (0.0, 0.0, 0.0)
     curve: Name | None = None
     faces: Literal["both", "bottom", "top", "mid"] = "both"
-    penalty: Positive = 0.1
-    DECK_KEY: ClassVar[str] = "contact"
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-    FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
 
     @model_validator(mode="after")
     def _shape_keys(self) -> "RigidTool":
@@ -93,7 +90,7 @@ class RigidTool(LoadTable):
         moving = f", moving by {list(self.motion)}" + (f" x curve '{self.curve}'" if self.curve else "") \
             if any(self.motion) else ""
         return (f"'{self.name}': rigid {self.shape} {where}{moving}; {self.faces} faces of '{self.set}'; "
-                f"penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}")
+                f"penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}{self.friction_summary}")
 
 
 TABLES = (RigidTool,)
@@ -108,8 +105,9 @@ class Bundle(NamedTuple):
     the deck's contacts; shape (K,) code of SHAPES; point, direction (K, 3) the tool's
     point and its plane normal or cylinder axis (unit); radius, side (K,) (+1 outside, -1
     inside); motion (K, 3) and curve (K,) its motion; faces (K, 2) the first and last face
-    tested; penalty (K,) the scale s; stiffness (K,) the springs k [force/length] (0 until
-    :func:`calibrate`)."""
+    tested; penalty (K,) the scale s; friction (K,) Coulomb's mu; stiffness (K,) the
+    springs k [force/length] and stick (K,) the damper [force/velocity] that stops a slip
+    within the critical step, k dt_c / s (0 until :func:`calibrate`)."""
 
     nodes: np.ndarray
     tool: np.ndarray
@@ -122,7 +120,9 @@ class Bundle(NamedTuple):
     curve: np.ndarray
     faces: np.ndarray
     penalty: np.ndarray
+    friction: np.ndarray
     stiffness: np.ndarray
+    stick: np.ndarray
 
 
 #: The bundle's fields that hold integers.
@@ -132,7 +132,7 @@ _INTEGERS = ("tool", "shape", "curve", "faces")
 def empty(scene) -> Bundle:
     """No rigid tool."""
     return _repeated(np.zeros(0, dtype=np.int64), tool=-1, shape=0, point=np.zeros(3), direction=np.zeros(3),
-                     radius=0.0, side=1.0, motion=np.zeros(3), curve=-1, faces=(0, 0), penalty=0.1)
+                     radius=0.0, side=1.0, motion=np.zeros(3), curve=-1, faces=(0, 0), penalty=0.1, friction=0.0)
 
 
 def build(table: RigidTool, scene) -> Bundle:
@@ -141,7 +141,8 @@ def build(table: RigidTool, scene) -> Bundle:
     return _repeated(scene.mesh.sets[table.set].nodes.astype(np.int64), tool=scene.place, shape=SHAPES[table.shape],
                      point=table.point, direction=direction / np.linalg.norm(direction), radius=table.radius or 0.0,
                      side=1.0 if table.side == "outside" else -1.0, motion=table.motion,
-                     curve=scene.curve_index(table.curve), faces=FACE_RANGES[table.faces], penalty=table.penalty)
+                     curve=scene.curve_index(table.curve), faces=FACE_RANGES[table.faces], penalty=table.penalty,
+                     friction=table.friction)
 
 
 def _repeated(nodes: np.ndarray, **tool) -> Bundle:
@@ -151,18 +152,20 @@ def _repeated(nodes: np.ndarray, **tool) -> Bundle:
         value = np.asarray(value, dtype=np.int64 if name in _INTEGERS else float)
         return np.broadcast_to(value, (len(nodes),) + value.shape).copy()
 
-    return Bundle(nodes=nodes, stiffness=np.zeros(len(nodes)), **{name: each(name, value) for name, value in tool.items()})
+    springs = {"stiffness": np.zeros(len(nodes)), "stick": np.zeros(len(nodes))}
+    return Bundle(nodes=nodes, **springs, **{name: each(name, value) for name, value in tool.items()})
 
 
 def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarray, dt: float) -> None:
     """Set the springs, in place: k = s / (dt^2 (1/m + (h/2)^2 / m_r)) at each contact
     node, from the translational and rotary masses (n,), the fibre lengths h (n,) and the
     structure's critical step dt (the lever arm only where a face off the mid-surface
-    touches)."""
+    touches); and the friction's dampers k dt / s."""
     n = loads.nodes
     arm = np.where(loads.faces[:, 0] != 0, 0.5 * h[n], 0.0) ** 2
     turning = np.divide(arm, rotary[n], out=np.zeros_like(arm), where=rotary[n] > 0.0)  # none where no rotary mass
     loads.stiffness[:] = loads.penalty / (dt * dt * (1.0 / masses[n] + turning))
+    loads.stick[:] = loads.stiffness * dt / loads.penalty
 
 
 def step_share(loads: Bundle) -> float:
@@ -196,6 +199,18 @@ def _distance(loads, m, centre, y, normal):
     return loads.side[m] * (size - loads.radius[m])
 
 
+@njit(cache=True, inline="always")
+def _face_gap(loads, m, centre, node, face, y, normal):
+    """(arm, gap) of the point y = x + arm d (3,) of ``face`` (-1, 0, +1; arm = face h/2)
+    of item m's node = (x, d (3,), fibre length h): its signed distance from the tool at
+    ``centre`` (3,), the unit normal there into ``normal`` (3,)."""
+    x, d, h = node
+    arm = 0.5 * face * h
+    for i in range(3):
+        y[i] = x[i] + arm * d[i]
+    return arm, _distance(loads, m, centre, y, normal)
+
+
 @njit(cache=True)
 def _node_forces(loads, m, centre, x, d, h, out, scratch):
     """out = (f, g) (3,): the contact force on item m's node at x, d (3,), h, and its
@@ -206,10 +221,7 @@ def _node_forces(loads, m, centre, x, d, h, out, scratch):
     g[:] = 0.0
     face = loads.faces[m, 0]
     while face <= loads.faces[m, 1]:
-        arm = 0.5 * face * h
-        for i in range(3):
-            y[i] = x[i] + arm * d[i]
-        gap = _distance(loads, m, centre, y, normal)
+        arm, gap = _face_gap(loads, m, centre, (x, d, h), face, y, normal)
         if gap < 0.0:
             push = -loads.stiffness[m] * gap
             for i in range(3):
@@ -239,6 +251,45 @@ def add_forces(t, model, shape, loads, f, g):
         for i in range(3):
             f[node, i] += fn[i]
             g[node, i] += gn[i]
+
+
+@njit(cache=True)
+def add_friction(t, model, shape, loads, f, g, v, w):
+    """f, g (n, 3) += the tools' friction at time t on the current ``shape`` moving at
+    the velocities v (n, 3), w (n, 2): at each face point in contact, against its
+    velocity relative to the tool tangent to it (the node's, its director's rate times
+    the lever arm, less the tool's), the smaller of mu times the push and the stick
+    damper times that velocity (which stops the slip within a critical step, as sticking
+    does)."""
+    if loads.nodes.shape[0] == 0:
+        return
+    centre, y, normal, slip = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    for m in range(loads.nodes.shape[0]):
+        if loads.friction[m] == 0.0:
+            continue
+        node = loads.nodes[m]
+        x, d, e1 = shape.x[node], shape.d[node], shape.e1[node]
+        _centre(loads, model.curves, m, t, centre)
+        moving = rate(model.curves, loads.curve[m], t)
+        e2 = cross(d, e1)
+        face = loads.faces[m, 0]
+        while face <= loads.faces[m, 1]:
+            arm, gap = _face_gap(loads, m, centre, (x, d, shape.h[node]), face, y, normal)
+            face += 2
+            if gap >= 0.0:
+                continue
+            for i in range(3):  # the director's rate is -w1 e1 - w2 e2
+                slip[i] = v[node, i] - arm * (w[node, 0] * e1[i] + w[node, 1] * e2[i]) - moving * loads.motion[m, i]
+            along = slip[0] * normal[0] + slip[1] * normal[1] + slip[2] * normal[2]
+            for i in range(3):
+                slip[i] -= along * normal[i]
+            speed = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
+            if speed == 0.0:
+                continue
+            drag = min(loads.friction[m] * -loads.stiffness[m] * gap, loads.stick[m] * speed) / speed
+            for i in range(3):
+                f[node, i] -= drag * slip[i]
+                g[node, i] -= arm * drag * slip[i]
 
 
 @njit(cache=True)

@@ -14,7 +14,9 @@ so neither side's nodes pass through; a node takes the nearest face it penetrate
 one that holds it, nor one it overlapped in the initial shape (neighbours of a thick
 shell, or two sets meshed overlapping; found once, when the model is built), as
 LS-DYNA's ``IGNORE`` does. The forces act at
-the mid-surface, on the translations only. Frictionless.
+the mid-surface, on the translations only. With ``friction`` mu, the node's velocity
+relative to the face point, tangent to the face, is opposed by mu times the push, spread
+back to the face's nodes by N_a (:func:`add_friction`).
 
 The penalty is the soft constraint of explicit codes: a spring between the node (mass
 m_y) and the face point (the face's masses m_a weighted by N_a^2) of
@@ -27,7 +29,7 @@ along the face.
 
 from __future__ import annotations
 
-from typing import ClassVar, Literal, NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -35,26 +37,21 @@ from numba import njit, prange
 from ..errors import MeshError
 from ..table_types import Name, Positive
 from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
-from .table import LoadTable
+from .table import ContactTable
 
 
-class ShellContact(LoadTable):
+class ShellContact(ContactTable):
     """Contact of the faces of the surface set ``set`` with those of ``against`` (leaflet on
     leaflet), or with its own (no ``against``: self-contact, a strip rolling over itself).
     ``offset``: the share of the half thicknesses kept between mid-surfaces (1: the faces
     touch). ``penalty``: the soft constraint's scale s (the critical step falls by the
-    factor 1 / sqrt(1 + s / 2)). ``name``: the history column of the contact force (the
-    sum of the contact forces' magnitudes, both ways)."""
+    factor 1 / sqrt(1 + s / 2)). ``friction``: Coulomb's mu between the faces. ``name``:
+    the history column of the contact force (the sum of the contact forces' magnitudes,
+    both ways)."""
 
     type: Literal["shells"]
-    name: Name
-    set: Name = "all"
     against: Name | None = None
     offset: Positive = 1.0
-    penalty: Positive = 0.1
-    DECK_KEY: ClassVar[str] = "contact"
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
-    FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
 
     @property
     def named_sets(self) -> dict[str, str]:
@@ -66,7 +63,8 @@ class ShellContact(LoadTable):
         """One line for ``shellsim check``."""
         other = f"'{self.against}'" if self.against else "itself"
         return (f"'{self.name}': shell faces of '{self.set}' against {other}, both ways, {self.offset:g} x the half "
-                f"thicknesses apart; penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}")
+                f"thicknesses apart; penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}"
+                f"{self.friction_summary}")
 
 
 TABLES = (ShellContact,)
@@ -93,8 +91,8 @@ class Bundle(NamedTuple):
 
     nodes (K,): each contact node; tool (K,): its table's place among the deck's
     contacts; group (K,): the faces it is tested against (those of the same group);
-    offset, penalty (K,): the table's; spring (K,): s / dt_c^2 and inverse_mass (K,):
-    1/m (0 until :func:`calibrate`); ignored (K, :data:`IGNORED`): the elements whose
+    offset, penalty, friction (K,): the table's; spring (K,): s / dt_c^2 and
+    inverse_mass (K,): 1/m (0 until :func:`calibrate`); ignored (K, :data:`IGNORED`): the elements whose
     faces the node overlaps in the initial shape (-1 after the last). faces (F, 9): each
     face's nodes; face_elements (F,) their elements; face_group (F,);
     face_inverse_mass (F, 9) (0 until :func:`calibrate`). Scratch: touches (K,) each
@@ -107,6 +105,7 @@ class Bundle(NamedTuple):
     group: np.ndarray
     offset: np.ndarray
     penalty: np.ndarray
+    friction: np.ndarray
     spring: np.ndarray
     inverse_mass: np.ndarray
     ignored: np.ndarray
@@ -158,7 +157,8 @@ def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> 
     return Bundle(
         nodes=nodes, tool=np.full(k, place, dtype=np.int64),
         group=joined([np.full(len(n), 2 * place + i) for i, (n, _) in enumerate(passes)]),
-        offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), spring=np.zeros(k),
+        offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), friction=np.full(k, table.friction),
+        spring=np.zeros(k),
         inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64),
         faces=conn[elements].astype(np.int64).reshape(-1, 9), face_elements=elements,
         face_group=joined([np.full(len(e), 2 * place + i) for i, (_, e) in enumerate(passes)]),
@@ -367,6 +367,49 @@ def add_forces(t, model, shape, loads, f, g):
             f[loads.nodes[m], i] += loads.touch_forces[m, 0, i]
             for a in range(9):
                 f[loads.faces[row, a], i] += loads.touch_forces[m, 1 + a, i]
+
+
+@njit(cache=True)
+def add_friction(t, model, shape, loads, f, g, v, w):
+    """f (n, 3) += the friction of the contacts :func:`add_forces` found on this ``shape``
+    (it reads what that left in loads.touches and loads.touch_forces), the nodes moving
+    at v (n, 3): against the contact node's velocity relative to the face point (N_a
+    v_a), tangent to the face, the smaller of mu times the push and the stick damper
+    times that velocity (the relative motion's mass over the critical step, 1 / (dt_c
+    (1/m_y + sum_a N_a^2 / m_a)): it stops the slip within a critical step, as sticking
+    does), on the node and back on the face's nodes by N_a. w (n, 2) unread: the forces
+    act at the mid-surface."""
+    slip, shares = np.empty(3), np.empty(9)
+    for m in range(loads.nodes.shape[0]):
+        row = loads.touches[m]
+        if row < 0 or loads.friction[m] == 0.0:
+            continue
+        pushed = loads.touch_forces[m]
+        push = np.sqrt(pushed[0, 0] ** 2 + pushed[0, 1] ** 2 + pushed[0, 2] ** 2)
+        if push == 0.0:
+            continue
+        node = loads.nodes[m]
+        slip[:] = v[node]
+        weight = loads.inverse_mass[m]
+        for a in range(9):  # N_a from the face's share of the push
+            shares[a] = -(pushed[1 + a, 0] * pushed[0, 0] + pushed[1 + a, 1] * pushed[0, 1]
+                          + pushed[1 + a, 2] * pushed[0, 2]) / (push * push)
+            weight += shares[a] * shares[a] * loads.face_inverse_mass[row, a]
+            for i in range(3):
+                slip[i] -= shares[a] * v[loads.faces[row, a], i]
+        along = (slip[0] * pushed[0, 0] + slip[1] * pushed[0, 1] + slip[2] * pushed[0, 2]) / push
+        for i in range(3):
+            slip[i] -= along * pushed[0, i] / push
+        speed = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
+        if speed == 0.0:
+            continue
+        critical = np.sqrt(loads.penalty[m] / loads.spring[m])
+        drag = min(loads.friction[m] * push, speed / (critical * weight)) / speed
+        for i in range(3):
+            f[node, i] -= drag * slip[i]
+        for a in range(9):
+            for i in range(3):
+                f[loads.faces[row, a], i] += shares[a] * drag * slip[i]
 
 
 @njit(cache=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from ..table_types import Section
+from ..table_types import Name, NonNegative, Positive, Section
 
 
 class LoadTable(Section):
@@ -32,3 +32,23 @@ class LoadTable(Section):
     def feature(self) -> str:
         """The plan's feature this load uses."""
         return self.FEATURES[0]
+
+
+class ContactTable(LoadTable):
+    """A ``[[contact]]`` table: its ``name`` (history columns), the surface ``set`` whose
+    faces touch, the penalty's scale and the Coulomb ``friction`` coefficient mu
+    (regularised: the sliding force is mu times the contact force, or less where that
+    would reverse the slip within a critical step, which is how sticking is held)."""
+
+    name: Name
+    set: Name = "all"
+    penalty: Positive = 0.1
+    friction: NonNegative = 0.0
+    DECK_KEY: ClassVar[str] = "contact"
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
+    FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
+
+    @property
+    def friction_summary(self) -> str:
+        """The friction for ``check``'s line: '' when frictionless."""
+        return f", friction {self.friction:g}" if self.friction else ""

@@ -63,6 +63,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "features": {"used": plan.used(), "left_out": plan.left_out()},
         **large_strain,
         **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
+        **({"contact": contact_record(run, output_seconds)} if run.tool_forces is not None else {}),
         "reference": reference_results(run),
     }
 
@@ -75,6 +76,16 @@ def static_record(run: Run) -> dict:
             "tangents": sum(s["tangents"] for s in steps),
             "cutbacks": sum(s["cutbacks"] for s in steps),
             "largest_residual": max((s["residual"] for s in steps), default=0.0), "steps": steps}
+
+
+def contact_record(run: Run, output_seconds: float) -> dict:
+    """What contact costs: the contact forces' wall time per evaluation (search included,
+    timed on the last shape) and, of an explicit run, its share of the mean step."""
+    per_evaluation = run.tool_forces.seconds_per_evaluation(run.load_time, run.sim.state.fields.shape)
+    record = {"us_per_evaluation": 1e6 * per_evaluation}
+    if run.deck.solver.method == "explicit" and run.sim.state.steps:
+        record["share_of_step"] = per_evaluation * run.sim.state.steps / max(run.wall_time - output_seconds, 1e-300)
+    return record
 
 
 def element_quality(run: Run) -> dict:

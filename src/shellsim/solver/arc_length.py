@@ -51,7 +51,8 @@ class LoadRate:
         self._external = TypedCall(external_forces)
 
     def _forces(self, t: float) -> np.ndarray:
-        self._external(float(t), self.sim.model, self.sim.state.fields.shape, self._f, self._fr, self._g)
+        fields = self.sim.state.fields
+        self._external(float(t), self.sim.model, fields.shape, fields.v, fields.w, self._f, self._fr, self._g)
         return self.unknowns.gather(self.unknowns.to_local(self._f, self._fr))[:self.unknowns.n_free]
 
     def __call__(self, t: float) -> np.ndarray:

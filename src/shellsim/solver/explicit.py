@@ -54,7 +54,7 @@ def forces(t, model, fields, space):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
     forces of the incremental formulation take the last step's increments from ``space``."""
     internal_forces(model, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int, space.parts)
-    external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g)
+    external_forces(t, model, fields.shape, fields.v, fields.w, fields.f_ext, fields.fr_ext, space.g)
 
 
 @njit(cache=True)

@@ -13,10 +13,6 @@ of three components on the quad9 cells (e.g. fibre directions) is kept by name.
 
 from __future__ import annotations
 
-import contextlib
-import io
-import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +20,7 @@ import numpy as np
 
 from ..errors import MeshError, id_list
 from ..mesh import NamedSet, edges_within
+from ..mesh_reading import read_meshio
 from .file_checks import (
     GMSH_QUAD9, collapsed_problem, missing_nodes_problem, point_data_problems, repeated_node_problem,
 )
@@ -52,30 +49,6 @@ class ImportedMesh:
     cell_vectors: dict[str, np.ndarray]
     point_fields: dict[str, np.ndarray]
     cell_fields: dict[str, np.ndarray]
-
-
-def read_meshio(path: Path):
-    """meshio's mesh of ``path``. meshio prints its complaints and calls ``sys.exit`` on a file
-    it cannot parse (which would end a study's worker): both are caught and become the message."""
-    import meshio
-
-    if not path.is_file():
-        raise MeshError(f"mesh file '{path}' not found")
-    said = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
-            mesh = meshio.read(path)
-    except (Exception, SystemExit) as err:  # meshio raises many types for unreadable files
-        complaints = " ".join(line.strip() for line in said.getvalue().splitlines() if line.strip())
-        reason = "; ".join(part for part in (complaints, str(err) if not isinstance(err, SystemExit) else "") if part)
-        raise MeshError(f"mesh file '{path}' could not be read (truncated, or not a mesh?): {reason}") from None
-    complaints = said.getvalue()
-    unclosed = re.search(r"\$(\w*) not closed", complaints)
-    if unclosed:  # meshio reads on past a cut-off section with only a warning
-        section = f"${unclosed.group(1)} section" if unclosed.group(1) else "last section"
-        raise MeshError(f"mesh file '{path}' is truncated: its {section} does not end")
-    sys.stderr.write(complaints)
-    return mesh
 
 
 def read_mesh(path: Path) -> ImportedMesh:

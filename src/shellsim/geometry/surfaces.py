@@ -23,33 +23,14 @@ import numpy as np
 
 from ..errors import MeshError, place
 from ..mesh import EDGES, NamedSet
+from ..mesh_reading import read_triangles
 from .gmsh_extract import extract
-from .importing import read_meshio
 
 #: Dihedral angle above which gmsh splits the surface into patches (degrees): a ridge
 #: sharper than this stays a ridge.
 RIDGE_DEG = 40.0
 #: Name prefix of the open boundary loops the deck does not name.
 LOOP_PREFIX = "open_"
-
-
-def read_triangles(path: Path) -> tuple[np.ndarray, np.ndarray]:
-    """Points (n, 3) and triangles (m, 3) of a surface file, unused points dropped."""
-    surface = read_meshio(path)
-    blocks = [np.asarray(b.data, dtype=np.int64) for b in surface.cells if b.type == "triangle"]
-    others = sorted({b.type for b in surface.cells if b.type not in ("triangle", "vertex", "line")})
-    if not blocks or others:
-        found = ", ".join(sorted({b.type for b in surface.cells})) or "no cells"
-        raise MeshError(f"surface file '{path}' should hold triangles only; found {found}")
-    triangles = np.concatenate(blocks)
-    points = np.asarray(surface.points, dtype=float)
-    if points.shape[1] == 2:
-        points = np.column_stack([points, np.zeros(len(points))])
-    bad = np.flatnonzero(~np.all(np.isfinite(points), axis=1))
-    if np.isin(bad, triangles).any():
-        raise MeshError(f"surface file '{path}' has points that are not finite numbers, e.g. point {bad[0]}")
-    used, triangles = np.unique(triangles, return_inverse=True)
-    return points[used], triangles.reshape(-1, 3)
 
 
 def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:

@@ -156,13 +156,10 @@ def build_grid(x, faces, reach, grid):
     face: its nodes' box grown by as far as a biquadratic face bulges past them (along
     each line of nodes, a quadratic overshoots them by at most an eighth of its second
     difference; across the lines, by 1.25 times that of the lines' values); each face is
-    listed in the cells its box grown by reach (F,) covers. Returns the cell width and
-    the grid's origin corner (3,)."""
-    boxes, start, entries = grid
-    n_faces = faces.shape[0]
-    origin = np.full(3, np.inf)
-    width = 0.0
-    for f in range(n_faces):
+    listed in the cells its box grown by reach (F,) covers (:func:`fill_grid`). Returns
+    the cell width and the grid's origin corner (3,)."""
+    boxes = grid[0]
+    for f in range(faces.shape[0]):
         for i in range(3):
             low, high = np.inf, -np.inf
             for a in range(9):
@@ -180,6 +177,22 @@ def build_grid(x, faces, reach, grid):
             bulge = 0.125 * along + 0.15625 * across
             boxes[f, i] = low - bulge
             boxes[f, 3 + i] = high + bulge
+    return fill_grid(reach, grid)
+
+
+@njit(cache=True)
+def fill_grid(reach, grid):
+    """The bucket grid of F boxes: grid = (boxes (F, 6) lower and upper corners, start
+    (B + 1,) each bucket's first entry, entries (8 F,) box rows by bucket), start and
+    entries filled in place. The cells are as wide as the widest box grown by reach (F,)
+    on every side, so a grown box covers at most 2 x 2 x 2 cells and is listed in each.
+    Returns the cell width and the grid's origin corner (3,)."""
+    boxes, start, entries = grid
+    n_faces = boxes.shape[0]
+    origin = np.full(3, np.inf)
+    width = 0.0
+    for f in range(n_faces):
+        for i in range(3):
             width = max(width, boxes[f, 3 + i] - boxes[f, i] + 2.0 * reach[f])
             origin[i] = min(origin[i], boxes[f, i] - reach[f])
     width = max(width, 1e-300)

@@ -48,6 +48,7 @@ def deck_from_data(data: dict, name: str = "<deck>", base_dir: Path | None = Non
     except ValidationError as err:
         raise DeckError(name, format_errors(err, data, text, Deck)) from None
     deck = _curve_files_read(deck, name, base_dir)
+    deck = _table_files_found(deck, name, base_dir)
     builder_sets = deck.geometry.sets() if deck.geometry.builder != "file" else None
     problems = check_references(deck, builder_sets)
     if problems:
@@ -70,6 +71,30 @@ def _curve_files_read(deck: Deck, name: str, base_dir: Path | None) -> Deck:
     if problems:
         raise DeckError(name, problems)
     return deck.model_copy(update={"curves": curves})
+
+
+def _table_files_found(deck: Deck, name: str, base_dir: Path | None) -> Deck:
+    """``deck`` with the files its load and contact tables name (their ``FILE_KEYS``) as
+    absolute paths, relative ones taken from the deck's folder; DeckError naming every
+    file that is not there."""
+    lists, problems = {}, []
+    for key in ("load", "contact"):
+        lists[key] = []
+        for i, table in enumerate(getattr(deck, key)):
+            found = {}
+            for file_key in table.FILE_KEYS:
+                given = getattr(table, file_key)
+                if given is None:
+                    continue
+                path = Path(given) if Path(given).is_absolute() or base_dir is None else base_dir / given
+                if not path.is_file():
+                    problems.append(f"{key}[{i}].{file_key}: file '{given}' not found"
+                                    + (f" (looked in {base_dir})" if base_dir is not None else ""))
+                found[file_key] = str(path.resolve())
+            lists[key].append(table.model_copy(update=found))
+    if problems:
+        raise DeckError(name, problems)
+    return deck.model_copy(update=lists)
 
 
 def resolve_mesh_path(deck: Deck, base_dir: Path | None) -> Path:

@@ -1,5 +1,7 @@
 """Contact of the shell's faces with a rigid tool: an analytic plane, sphere or cylinder
-that a curve may move (the rigid walls of LS-DYNA), by penalty.
+(the rigid walls of LS-DYNA), or a triangulated surface read from a file (a stent, a
+catheter, a balloon: :mod:`shellsim.loads.tool_surface`), that a curve may move, by
+penalty.
 
 Each node of the contact set is tested on the faces it offers, the points
 y = x + t h/2 d (t = -1 bottom, +1 top, 0 the mid-surface), against the tool's signed
@@ -22,7 +24,8 @@ counted there too).
 
 from __future__ import annotations
 
-from typing import Literal, NamedTuple
+from pathlib import Path
+from typing import ClassVar, Literal, NamedTuple
 
 import numpy as np
 from numba import njit
@@ -33,27 +36,32 @@ from ..element.frames import cross
 from ..element.tangent import moved_node
 from ..table_types import Name, Positive, Vec3
 from .table import ContactTable
+from .tool_surface import read_tool, search_grid, signed_distance
 
 #: Codes of the tools' shapes.
-SHAPES = {"plane": 0, "sphere": 1, "cylinder": 2}
+SHAPES = {"plane": 0, "sphere": 1, "cylinder": 2, "surface": 3}
 #: (first, last) face of each ``faces`` choice, stepped by 2.
 FACE_RANGES = {"both": (-1, 1), "bottom": (-1, -1), "top": (1, 1), "mid": (0, 0)}
 
 
 class RigidTool(ContactTable):
     """A rigid tool the faces of a surface set may not pass: ``shape = "plane"`` through
-    ``point`` with unit ``normal`` pointing to the shell's side; ``"sphere"`` of ``radius``
-    centred at ``point``; ``"cylinder"`` of ``radius`` about the line through ``point``
-    along ``axis``. The shell is kept ``outside`` the sphere or cylinder (a punch, a
-    stent's outside) or ``inside`` it (a vessel in a tube). The tool moves by ``motion *
-    curve(t)``. ``faces``: the shell's faces that touch it (``both``, ``bottom``, ``top``
-    or the ``mid`` surface). ``penalty``: the soft constraint's scale s (the critical step
-    falls by the factor 1 / sqrt(1 + s / 4)). ``friction``: Coulomb's mu between the shell
-    and the tool. ``name``: the history column of the force the tool takes (its
+    ``point`` with unit ``normal`` pointing to the shell's side; ``"sphere"`` of
+    ``radius`` centred at ``point``; ``"cylinder"`` of ``radius`` about the line through
+    ``point`` along ``axis``; ``"surface"``: the triangulated surface in ``file`` (STL,
+    OBJ, PLY, VTP, OFF; a path relative to the deck, its coordinates shifted by
+    ``point``). The shell is kept ``outside`` the sphere, cylinder or surface (a punch,
+    a stent's outside; a surface's outside is the side its triangles' normals face) or
+    ``inside`` it (a vessel in a tube). The tool moves by ``motion * curve(t)``.
+    ``faces``: the shell's faces that touch it (``both``, ``bottom``, ``top`` or the
+    ``mid`` surface). ``penalty``: the soft constraint's scale s (the critical step
+    falls by the factor 1 / sqrt(1 + s / 4)). ``friction``: Coulomb's mu between the
+    shell and the tool. ``name``: the history column of the force the tool takes (its
     magnitude)."""
 
     type: Literal["rigid_tool"]
-    shape: Literal["plane", "sphere", "cylinder"]
+    shape: Literal["plane", "sphere", "cylinder", "surface"]
+    file: str | None = None
     point: Vec3 = (0.0, 0.0, 0.0)
     normal: Vec3 | None = None
     axis: Vec3 | None = None
@@ -62,12 +70,14 @@ class RigidTool(ContactTable):
     motion: Vec3 = (0.0, 0.0, 0.0)
     curve: Name | None = None
     faces: Literal["both", "bottom", "top", "mid"] = "both"
+    FILE_KEYS: ClassVar[tuple[str, ...]] = ("file",)
 
     @model_validator(mode="after")
     def _shape_keys(self) -> "RigidTool":
-        needs = {"plane": ("normal",), "sphere": ("radius",), "cylinder": ("axis", "radius")}[self.shape]
+        needs = {"plane": ("normal",), "sphere": ("radius",), "cylinder": ("axis", "radius"),
+                 "surface": ("file",)}[self.shape]
         missing = [key for key in needs if getattr(self, key) is None]
-        extra = [key for key in ("normal", "axis", "radius") if key not in needs and getattr(self, key) is not None]
+        extra = [key for key in ("normal", "axis", "radius", "file") if key not in needs and getattr(self, key) is not None]
         if missing or extra:
             raise ValueError(f"shape = '{self.shape}' takes {', '.join(needs)}"
                              + (f"; missing {', '.join(missing)}" if missing else "")
@@ -86,7 +96,8 @@ class RigidTool(ContactTable):
         where = {"plane": f"through {list(self.point)} facing {list(self.normal or ())}",
                  "sphere": f"of radius {self.radius} at {list(self.point)}, the shell {self.side}",
                  "cylinder": f"of radius {self.radius} about {list(self.axis or ())} through {list(self.point)}, "
-                             f"the shell {self.side}"}[self.shape]
+                             f"the shell {self.side}",
+                 "surface": f"'{self.file}' shifted by {list(self.point)}, the shell {self.side}"}[self.shape]
         moving = f", moving by {list(self.motion)}" + (f" x curve '{self.curve}'" if self.curve else "") \
             if any(self.motion) else ""
         return (f"'{self.name}': rigid {self.shape} {where}{moving}; {self.faces} faces of '{self.set}'; "
@@ -107,7 +118,13 @@ class Bundle(NamedTuple):
     inside); motion (K, 3) and curve (K,) its motion; faces (K, 2) the first and last face
     tested; penalty (K,) the scale s; friction (K,) Coulomb's mu; stiffness (K,) the
     springs k [force/length] and stick (K,) the damper [force/velocity] that stops a slip
-    within the critical step, k dt_c / s (0 until :func:`calibrate`)."""
+    within the critical step, k dt_c / s (0 until :func:`calibrate`).
+
+    The surface tools' triangles (T,), in their files' frames: corners (T, 3, 3),
+    pseudo (T, 7, 3) their pseudo-normals, owner (T,) their tool's place; their search
+    grid, one over every surface tool, made by :func:`calibrate`: boxes (T, 6), start
+    (2 T + 1 per tool,), entries (8 T,), and grid (K, 5) its cell width, origin corner
+    (3,) and reach (the largest fibre length of the tools' nodes), alike for every item."""
 
     nodes: np.ndarray
     tool: np.ndarray
@@ -123,6 +140,13 @@ class Bundle(NamedTuple):
     friction: np.ndarray
     stiffness: np.ndarray
     stick: np.ndarray
+    corners: np.ndarray
+    pseudo: np.ndarray
+    owner: np.ndarray
+    boxes: np.ndarray
+    start: np.ndarray
+    entries: np.ndarray
+    grid: np.ndarray
 
 
 #: The bundle's fields that hold integers.
@@ -136,24 +160,32 @@ def empty(scene) -> Bundle:
 
 
 def build(table: RigidTool, scene) -> Bundle:
-    """The contact nodes of one tool: the nodes of its set."""
+    """The contact nodes of one tool: the nodes of its set (and a surface's triangles)."""
     direction = np.asarray(table.normal if table.shape == "plane" else table.axis or (0.0, 0.0, 1.0), dtype=float)
-    return _repeated(scene.mesh.sets[table.set].nodes.astype(np.int64), tool=scene.place, shape=SHAPES[table.shape],
-                     point=table.point, direction=direction / np.linalg.norm(direction), radius=table.radius or 0.0,
-                     side=1.0 if table.side == "outside" else -1.0, motion=table.motion,
+    surface = read_tool(Path(table.file)) if table.shape == "surface" else None
+    return _repeated(scene.mesh.sets[table.set].nodes.astype(np.int64), surface, tool=scene.place,
+                     shape=SHAPES[table.shape], point=table.point, direction=direction / np.linalg.norm(direction),
+                     radius=table.radius or 0.0, side=1.0 if table.side == "outside" else -1.0, motion=table.motion,
                      curve=scene.curve_index(table.curve), faces=FACE_RANGES[table.faces], penalty=table.penalty,
                      friction=table.friction)
 
 
-def _repeated(nodes: np.ndarray, **tool) -> Bundle:
-    """A :class:`Bundle` of one tool's ``nodes`` (K,), its values (every field but the nodes
-    and the springs) repeated for each."""
+def _repeated(nodes: np.ndarray, surface: tuple[np.ndarray, np.ndarray] | None = None, **tool) -> Bundle:
+    """A :class:`Bundle` of one tool's ``nodes`` (K,), its values (every field but the nodes,
+    the springs and the surface) repeated for each; ``surface``: (corners, pseudo) of
+    its triangles (:func:`shellsim.loads.tool_surface.read_tool`), None for none."""
     def each(name, value):
         value = np.asarray(value, dtype=np.int64 if name in _INTEGERS else float)
         return np.broadcast_to(value, (len(nodes),) + value.shape).copy()
 
-    springs = {"stiffness": np.zeros(len(nodes)), "stick": np.zeros(len(nodes))}
-    return Bundle(nodes=nodes, **springs, **{name: each(name, value) for name, value in tool.items()})
+    k = len(nodes)
+    corners, pseudo = surface if surface is not None else (np.zeros((0, 3, 3)), np.zeros((0, 7, 3)))
+    t = len(corners)
+    triangles = {"corners": corners, "pseudo": pseudo, "owner": np.full(t, tool["tool"], dtype=np.int64),
+                 "boxes": np.zeros((t, 6)), "start": np.zeros(2 * t + 1 if t else 0, dtype=np.int64),
+                 "entries": np.zeros(8 * t, dtype=np.int64), "grid": np.zeros((k, 5))}
+    springs = {"stiffness": np.zeros(k), "stick": np.zeros(k)}
+    return Bundle(nodes=nodes, **springs, **triangles, **{name: each(name, value) for name, value in tool.items()})
 
 
 def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarray, dt: float) -> None:
@@ -166,6 +198,10 @@ def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarr
     turning = np.divide(arm, rotary[n], out=np.zeros_like(arm), where=rotary[n] > 0.0)  # none where no rotary mass
     loads.stiffness[:] = loads.penalty / (dt * dt * (1.0 / masses[n] + turning))
     loads.stick[:] = loads.stiffness * dt / loads.penalty
+    if len(loads.corners):  # the surfaces' grid, once: the tools only translate
+        reach = h[n[loads.shape == SHAPES["surface"]]].max()
+        loads.boxes[:], loads.start[:], loads.entries[:], frame = search_grid(loads.corners, reach)
+        loads.grid[:] = np.append(frame, reach)
 
 
 def step_share(loads: Bundle) -> float:
@@ -184,6 +220,15 @@ def _distance(loads, m, centre, y, normal):
     """The signed distance of the point y (3,) from tool item m whose point is now
     ``centre`` (3,), positive on the shell's side; writes the unit normal (3,) there."""
     shape = loads.shape[m]
+    if shape == 3:
+        tool = (loads.corners, loads.pseudo, loads.owner, loads.boxes, loads.start, loads.entries, loads.grid[m, :4],
+                loads.grid[m, 4])
+        gap = signed_distance(tool, loads.tool[m], (y[0] - centre[0], y[1] - centre[1], y[2] - centre[2]), normal)
+        if gap == np.inf:  # far from the surface
+            return gap
+        for i in range(3):
+            normal[i] *= loads.side[m]
+        return loads.side[m] * gap
     if shape == 0:
         normal[:] = loads.direction[m]
         return (y[0] - centre[0]) * normal[0] + (y[1] - centre[1]) * normal[1] + (y[2] - centre[2]) * normal[2]

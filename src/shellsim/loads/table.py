@@ -16,12 +16,15 @@ class LoadTable(Section):
     SET_KINDS: the kinds of set it acts on (:mod:`shellsim.deck.references` checks them);
     FEATURES: the plan's features (:mod:`shellsim.plan`) this table may use, the first
     unless :attr:`feature` says otherwise; QUANTITY: what ``value`` is, for plot axes:
-    "stress" (force per area) or "load"."""
+    "stress" (force per area) or "load"; FILE_KEYS: its keys that name a file, a path
+    relative to the deck (the deck's reading makes them absolute and checks that they
+    exist)."""
 
     DECK_KEY: ClassVar[str] = "load"
     SET_KINDS: ClassVar[tuple[str, ...]]
     FEATURES: ClassVar[tuple[str, ...]]
     QUANTITY: ClassVar[str] = "load"
+    FILE_KEYS: ClassVar[tuple[str, ...]] = ()
 
     @property
     def named_sets(self) -> dict[str, str]:

@@ -68,6 +68,22 @@ def test_a_sphere_and_a_cylinder_push_along_their_radius_by_the_depth(shape, cen
     np.testing.assert_allclose(f[~inside], 0.0, atol=1e-15)
 
 
+def test_the_gap_to_a_tool_is_the_clearance_of_the_nearest_face_and_its_springs_hold_k_gap_squared_over_two():
+    """The plate 0.1 above a plane through z = 0 (h = 0.02): every node's gap is its bottom
+    face's height, 0.1 - h/2, and the springs hold nothing; 0.005 below it, the overlap
+    -0.015 as a negative gap, and each node's spring k 0.015^2 / 2."""
+    from shellsim.bundles import Shape
+    from shellsim.loads import ToolForces
+
+    k = 0.1 / (1.0 + 0.01**2)
+    for lift, expected in ((0.1, 0.09), (-0.005, -0.015)):
+        _, _, _, model = tool_forces('shape = "plane"\nnormal = [0.0, 0.0, 1.0]', lift=lift)
+        shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+        np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, shape), expected, rtol=1e-12)
+        stored = ToolForces(model, ["tool"])(0.0, shape)["tool_energy"]
+        assert stored == pytest.approx(model.n_nodes * 0.5 * k * min(expected, 0.0) ** 2, rel=1e-12, abs=1e-300)
+
+
 def test_the_critical_step_falls_by_the_stated_factor():
     _, _, _, model = tool_forces('shape = "plane"\nnormal = [0.0, 0.0, 1.0]\npenalty = 0.5')
     assert step_share(model) == pytest.approx(1.0 / np.sqrt(1.0 + 0.5 / 4.0), rel=1e-15)
@@ -235,14 +251,18 @@ shape = "plane"
 point = [0.0, 0.0, -0.01]
 normal = [0.0, 0.0, 1.0]
 [output]
-fields = ["displacement", "contact_pressure"]
+fields = ["displacement", "contact_pressure", "contact_gap"]
 formats = ["vtu"]
 ''').replace("thickness = 0.01", "thickness = 0.02").replace("end_time = 1.0", 'method = "static"\nend_time = 1.0'))
     ran = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
     assert ran.exit_code == 0, ran.output
     (last,) = sorted((tmp_path / "out" / "frames").glob("*.vtu"))[-1:]
-    pressure = meshio.read(last).point_data["contact_pressure"]
-    np.testing.assert_allclose(pressure, p, rtol=1e-9)
+    frame = meshio.read(last).point_data
+    np.testing.assert_allclose(frame["contact_pressure"], p, rtol=1e-9)
+    # the gap field: the bottom face started on the plane, so its overlap is how far the
+    # plate sank (the penalty's give; the thickness is kept)
+    assert np.all(frame["contact_gap"] < 0.0)
+    np.testing.assert_allclose(frame["contact_gap"], frame["displacement"][:, 2], rtol=1e-9)
     import csv
 
     rows = list(csv.DictReader((tmp_path / "out" / "history.csv").open()))

@@ -172,21 +172,29 @@ end_time = 1.0
 """
 
 
-def stacked_plates(path: Path, lower: int, upper: int, lift: float = 0.0, thickness: float = 0.01) -> Path:
-    """A mesh file of two unit plates: ``lower`` x ``lower`` elements at z = 0 and ``upper``
-    x ``upper`` at z = thickness + lift (their faces touching at lift 0), as surface sets
-    'lower' and 'upper' beside the builder's sets of the lower one (x0, y1, ...)."""
-    def plate(n: int, z: float) -> Mesh:
+def stacked_plates(path: Path, lower: int | tuple[int, int], upper: int | tuple[int, int], lift: float = 0.0,
+                   thickness: float = 0.01) -> Path:
+    """A mesh file of two unit plates: ``lower`` elements (n for n x n, or (along x, along
+    y)) at z = 0 and ``upper`` at z = thickness + lift (their faces touching at lift 0),
+    as surface sets 'lower' and 'upper' beside the builder's sets of the lower one (x0,
+    y1, ...) and of the upper one, named upper_x0, upper_y1, ..."""
+    def plate(n: int | tuple[int, int], z: float) -> Mesh:
+        length, width = (n, n) if isinstance(n, int) else n
         deck = parse_deck(PLATES + '[geometry]\nbuilder = "rectangle"\nlength = 1.0\nwidth = 1.0\n'
-                                   f'[mesh]\ndivisions = {{ length = {n}, width = {n} }}\n')
+                                   f'[mesh]\ndivisions = {{ length = {length}, width = {width} }}\n')
         mesh = build_mesh(deck)
         mesh.x[:, 2] += z
         return mesh
 
+    def shifted(named: NamedSet) -> NamedSet:
+        return NamedSet(named.kind, a.n_nodes + named.nodes,
+                        elements=None if named.elements is None else a.n_elements + named.elements,
+                        edges=None if named.edges is None else a.n_nodes + named.edges)
+
     a, b = plate(lower, 0.0), plate(upper, thickness + lift)
-    sets = dict(a.sets) | {"lower": NamedSet("surface", np.arange(a.n_nodes), elements=np.arange(a.n_elements)),
-                           "upper": NamedSet("surface", a.n_nodes + np.arange(b.n_nodes),
-                                             elements=a.n_elements + np.arange(b.n_elements))}
+    sets = dict(a.sets) | {f"upper_{name}": shifted(named) for name, named in b.sets.items() if name != "all"} \
+        | {"lower": NamedSet("surface", np.arange(a.n_nodes), elements=np.arange(a.n_elements)),
+           "upper": shifted(NamedSet("surface", np.arange(b.n_nodes), elements=np.arange(b.n_elements)))}
     write_mesh_vtu(Mesh(x=np.vstack([a.x, b.x]), conn=np.vstack([a.conn, b.conn + a.n_nodes]),
                         director=np.vstack([a.director, b.director]),
                         thickness=np.full(a.n_nodes + b.n_nodes, thickness), sets=sets), path)

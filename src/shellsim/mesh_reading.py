@@ -8,6 +8,7 @@ import contextlib
 import io
 import re
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +25,9 @@ def read_meshio(path: Path):
         raise MeshError(f"mesh file '{path}' not found")
     said = io.StringIO()
     try:
-        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said), warnings.catch_warnings():
+            # meshio takes an ASCII STL's first bytes for a facet count to test for binary
+            warnings.simplefilter("ignore", RuntimeWarning)
             mesh = meshio.read(path)
     except (Exception, SystemExit) as err:  # meshio raises many types for unreadable files
         complaints = " ".join(line.strip() for line in said.getvalue().splitlines() if line.strip())

@@ -235,7 +235,7 @@ class Solver(Section):
 
 OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
-    "pressure_band", "green_lagrange_strain", "von_mises", "fibres", "contact_pressure",
+    "pressure_band", "green_lagrange_strain", "von_mises", "fibres", "contact_pressure", "contact_gap",
 ]
 #: The probes' vocabulary (one place: the schema, the probes and the renders read it).
 #: Quantities by kind; those read at the integration point nearest to a probe's set.
@@ -494,9 +494,9 @@ class Deck(Section):
         problems += _constitutive_path_problems(self.material, self.section)
         if self.output.mirror and not any(b.type == "symmetry" for b in self.boundary):
             problems.append("output.mirror: the deck has no symmetry boundary to mirror across")
-        if "contact_pressure" in self.output.fields and not self.contact:
-            problems.append("output.fields: 'contact_pressure' is the pressure of the [[contact]] tables, and the "
-                            "deck has none")
+        problems += [f"output.fields: '{name}' is the {what} of the [[contact]] tables, and the deck has none"
+                     for name, what in (("contact_pressure", "pressure"), ("contact_gap", "gap"))
+                     if name in self.output.fields and not self.contact]
         if "fibres" in self.output.fields and not self.material.ANISOTROPIC:
             problems.append(f"output.fields: 'fibres' draws a fibre-reinforced law's fibres, and material.model = "
                             f"'{self.material.model}' has none")

@@ -25,9 +25,17 @@ and, when it has kernels of its own,
   sum of their magnitudes, what two sides of the shell press on each other with), and
   ``SIDES``, how many of the shell's sides a contact's nodes are on (1: a tool's; 2:
   both sides of a contact between shells, whose nodes' areas count each contact twice);
+  compiled ``item_gaps(t, model, shape, bundle, out)``, each contact node's gap (the
+  clearance between its face and what it may touch; +inf beyond the search's reach),
+  and ``item_energies(t, model, shape, bundle, out)``, the energy in its springs;
 - where it has friction: compiled ``add_friction(t, model, shape, bundle, f, g, v, w)``,
   its sliding forces at the velocities v (n, 3), w (n, 2), added after its
   ``add_forces`` on the same shape (it may read what that left in the bundle);
+- where its surfaces can pass through each other (contact between shells): compiled
+  ``deepest(t, model, shape, bundle)``, (item, share) the contact node that has gone
+  deepest through the offset between the surfaces and by what share of it, and
+  ``farthest_moved(t, model, shape, bundle, before)``, of those near a face the one that
+  moved farthest since the positions ``before`` (n, 3), by what share of its offset;
 - where its forces couple nodes that share no element (contact between shells):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
@@ -127,28 +135,56 @@ def step_share(model) -> float:
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)
 
 
+#: The share of its offset a contact node may go through, or move in one load step, in
+#: an equilibrium: a node deeper has passed through (a load step too long for the
+#: penalty, or a penalty too soft to hold the surfaces apart); one that moved farther may
+#: have passed a face unseen (a node against face contact measures no side), and the
+#: state answers nothing. Half: no node can reach a face's mid-surface in one step.
+PASSED_THROUGH = 0.5
+
+
+def passed_through(model, t: float, shape: Shape, before: np.ndarray) -> str | None:
+    """Why the contact surfaces of ``shape`` at time t may have passed through each other
+    since the positions ``before`` (n, 3) (:data:`PASSED_THROUGH`), naming the node; None
+    where they cannot have."""
+    for kind, bundle in _with(model, "deepest"):
+        item, share = kind.farthest_moved(float(t), model, shape, bundle, before)
+        if share > PASSED_THROUGH:
+            return (f"contact node {bundle.nodes[item] + 1} (numbered from 1) moved {share:.2g} times its offset "
+                    f"between the surfaces in one load step, far enough to pass through a face unseen")
+        item, share = kind.deepest(float(t), model, shape, bundle)
+        if share > PASSED_THROUGH:
+            return (f"contact node {bundle.nodes[item] + 1} (numbered from 1) has gone {share:.0%} of the way through "
+                    f"the offset to the face it touches: the surfaces pass through each other (a load step too long "
+                    f"for the penalty, or a penalty too soft to hold them apart)")
+    return None
+
+
 class ToolForces:
-    """The contact tables' measures from the kinds' compiled ``item_forces``: each table's
-    force (its kind's ``FORCE_TOTAL``) by the table's ``name`` and its contact area (the
-    initial mid-surface shares of the nodes in contact, over the kind's ``SIDES``) by
-    ``name_area`` (history columns, :func:`measure_names`), and the contact force at each
-    node (output fields)."""
+    """The contact tables' measures from the kinds' compiled ``item_forces`` and
+    ``item_energies``: each table's force (its kind's ``FORCE_TOTAL``) by the table's
+    ``name``, its contact area (the initial mid-surface shares of the nodes in contact,
+    over the kind's ``SIDES``) by ``name_area`` and the energy in its springs by
+    ``name_energy`` (history columns, :func:`measure_names`); the contact force and gap
+    at each node (output fields)."""
 
     def __init__(self, model, names: list[str]):
         self.model, self.names = model, names
         kinds = _with(model, "item_forces")
-        self._calls = [(TypedCall(kind.item_forces), bundle, np.zeros((len(bundle.tool), 3)), kind)
-                       for kind, bundle in kinds]
+        self._calls = [(TypedCall(kind.item_forces), TypedCall(kind.item_energies), bundle,
+                        (np.zeros((len(bundle.tool), 3)), np.zeros(len(bundle.tool))), kind) for kind, bundle in kinds]
         self._forces = [(TypedCall(kind.add_forces), bundle) for kind, bundle in kinds]
+        self._gaps = [(TypedCall(kind.item_gaps), bundle) for kind, bundle in kinds]
         # the areas only where there are columns to fill (the output field has its own)
         self._areas = node_areas(model.x0, model.conn) if self._calls and names else None
 
     def __call__(self, t: float, shape: Shape) -> dict[str, float]:
         totals = np.zeros((len(self.names), 3))
-        forces, areas = np.zeros(len(self.names)), np.zeros(len(self.names))
+        forces, areas, energies = np.zeros(len(self.names)), np.zeros(len(self.names)), np.zeros(len(self.names))
         resultant = np.zeros(len(self.names), dtype=bool)
-        for item_forces, bundle, out, kind in self._calls:
+        for item_forces, item_energies, bundle, (out, stored), kind in self._calls:
             item_forces(float(t), self.model, shape, bundle, out)
+            item_energies(float(t), self.model, shape, bundle, stored)
             magnitude = np.linalg.norm(out, axis=1)
             if kind.FORCE_TOTAL == "resultant":
                 np.add.at(totals, bundle.tool, out)
@@ -156,8 +192,9 @@ class ToolForces:
             else:
                 np.add.at(forces, bundle.tool, magnitude)
             np.add.at(areas, bundle.tool, np.where(magnitude > 0.0, self._areas[bundle.nodes], 0.0) / kind.SIDES)
+            np.add.at(energies, bundle.tool, stored)
         forces[resultant] = np.linalg.norm(totals[resultant], axis=1)
-        return dict(zip(measure_names(self.names), np.column_stack([forces, areas]).ravel().tolist()))
+        return dict(zip(measure_names(self.names), np.column_stack([forces, areas, energies]).ravel().tolist()))
 
     def seconds_per_evaluation(self, t: float, shape: Shape, repeats: int = 5) -> float:
         """The median wall time [s] of every contact kind's forces at time t on ``shape``
@@ -171,6 +208,18 @@ class ToolForces:
             times.append(time.perf_counter() - start)
         return float(np.median(times))
 
+    def gaps(self, t: float, shape: Shape) -> np.ndarray:
+        """(n,) each node's contact gap at time t: the least clearance between a face it
+        offers and what a contact table lets it touch (negative: overlapping), NaN for a
+        node in no contact or farther than the search reaches."""
+        gaps = np.full(self.model.n_nodes, np.inf)
+        for item_gaps, bundle in self._gaps:
+            out = np.empty(len(bundle.nodes))
+            item_gaps(float(t), self.model, shape, bundle, out)
+            np.minimum.at(gaps, bundle.nodes, out)
+        gaps[np.isinf(gaps)] = np.nan
+        return gaps
+
     def at_nodes(self, t: float, shape: Shape) -> np.ndarray:
         """(n, 3) the contact force on each node at time t: every contact kind's forces,
         a face's share of what its contact nodes take included."""
@@ -181,9 +230,9 @@ class ToolForces:
 
 
 def measure_names(names: list[str]) -> list[str]:
-    """The history columns of contact tables of these ``name``s: each name (its force)
-    and name_area (its contact area)."""
-    return [column for name in names for column in (name, f"{name}_area")]
+    """The history columns of contact tables of these ``name``s: each name (its force),
+    name_area (its contact area) and name_energy (the energy in its springs)."""
+    return [column for name in names for column in (name, f"{name}_area", f"{name}_energy")]
 
 
 def _chained(name: str, positions: tuple[int, ...]):

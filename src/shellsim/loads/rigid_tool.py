@@ -348,6 +348,43 @@ def item_forces(t, model, shape, loads, out):
 
 
 @njit(cache=True)
+def _clearance(t, model, shape, loads, m, scratch):
+    """(gap, energy) of item m at time t: the least signed distance of the faces its node
+    offers from the tool (+inf: a surface tool farther than its reach), and the energy
+    k gap^2 / 2 of its springs over the faces that overlap. scratch: (centre, y,
+    normal) (3,)."""
+    centre, y, normal = scratch
+    node = loads.nodes[m]
+    _centre(loads, model.curves, m, t, centre)
+    least, energy = np.inf, 0.0
+    face = loads.faces[m, 0]
+    while face <= loads.faces[m, 1]:
+        gap = _face_gap(loads, m, centre, (shape.x[node], shape.d[node], shape.h[node]), face, y, normal)[1]
+        least = min(least, gap)
+        if gap < 0.0:
+            energy += 0.5 * loads.stiffness[m] * gap * gap
+        face += 2
+    return least, energy
+
+
+@njit(cache=True)
+def item_gaps(t, model, shape, loads, out):
+    """out (K,): each contact node's gap from its tool at time t (:func:`_clearance`)."""
+    scratch = (np.empty(3), np.empty(3), np.empty(3))
+    for m in range(loads.nodes.shape[0]):
+        out[m] = _clearance(t, model, shape, loads, m, scratch)[0]
+
+
+@njit(cache=True)
+def item_energies(t, model, shape, loads, out):
+    """out (K,): the energy stored in each contact node's springs at time t
+    (:func:`_clearance`)."""
+    scratch = (np.empty(3), np.empty(3), np.empty(3))
+    for m in range(loads.nodes.shape[0]):
+        out[m] = _clearance(t, model, shape, loads, m, scratch)[1]
+
+
+@njit(cache=True)
 def add_tangent(t, model, shape, loads, step_u, step_r, k):
     """k (ne, 45, 45) -= the derivative of each contact node's force and rotational force
     with respect to its five DOFs (central differences, order and steps as

@@ -81,6 +81,10 @@ IGNORED = 32
 #: is none).
 TOUCHING = 1e-3
 
+#: How much farther than the contact's reach the gaps are looked for (an output's, not
+#: the search's: the clearance up to about a thickness shows where faces come close).
+GAP_REACH = 2.0
+
 #: The history column of this kind is the sum of its forces' magnitudes; a contact has
 #: nodes on both sides.
 FORCE_TOTAL, SIDES = "magnitudes", 2
@@ -222,11 +226,11 @@ def _holds(nodes, node):
 
 
 @njit(cache=True)
-def _grid(shape, loads):
+def _grid(shape, loads, widening):
     """The search grid of the faces on the current shape: each face's box grown by the
     largest reach of a contact (half its own largest and the largest node's fibre
-    length, times the offset, and the smoothing). Returns (width, origin)
-    (:func:`build_grid`)."""
+    length, times the offset, and the smoothing), times ``widening``. Returns (width,
+    origin) (:func:`build_grid`)."""
     h = shape.h
     deepest = 0.0
     for m in range(loads.nodes.shape[0]):
@@ -235,7 +239,7 @@ def _grid(shape, loads):
         thickest = 0.0
         for a in range(9):
             thickest = max(thickest, h[loads.faces[f, a]])
-        loads.reach[f] = 0.5 * (deepest + thickest) * (1.0 + TOUCHING)
+        loads.reach[f] = 0.5 * (deepest + thickest) * (1.0 + TOUCHING) * widening
     return build_grid(shape.x, loads.faces, loads.reach, (loads.boxes, loads.start, loads.entries))
 
 
@@ -253,8 +257,7 @@ def _candidates(shape, loads, m, grid, work, ignoring):
     best, deepest, listed = -1, -np.inf, 0
     for entry in range(first, stop):
         row = loads.entries[entry]
-        if loads.face_group[row] != loads.group[m] or not near_box(y, loads.boxes, row, loads.reach[row]) \
-                or _holds(loads.faces[row], node) or (ignoring and _ignored(loads, m, row)):
+        if not _may_touch(loads, m, row, y, ignoring):
             continue
         depth, smoothing = _depth(shape.x, shape.h, loads, m, row, work)
         if depth <= -smoothing:
@@ -268,6 +271,15 @@ def _candidates(shape, loads, m, grid, work, ignoring):
         elif depth > deepest:
             best, deepest = row, depth
     return best
+
+
+@njit(cache=True, inline="always")
+def _may_touch(loads, m, row, y, ignoring):
+    """Whether contact node m, at y (3,), is tested against face row ``row``: a face of its
+    group within the search's reach that does not hold it (nor, where ``ignoring``, one
+    it overlapped in the initial shape)."""
+    return loads.face_group[row] == loads.group[m] and near_box(y, loads.boxes, row, loads.reach[row]) \
+        and not _holds(loads.faces[row], loads.nodes[m]) and not (ignoring and _ignored(loads, m, row))
 
 
 @njit(cache=True)
@@ -295,12 +307,27 @@ def _initial_overlaps(initial, loads):
     Returns the first contact node that overlaps more than :data:`IGNORED`, or -1."""
     if loads.nodes.shape[0] == 0:
         return -1
-    grid = _grid(initial, loads)
+    grid = _grid(initial, loads, 1.0)
     work = _work()
     for m in range(loads.nodes.shape[0]):
         if _candidates(initial, loads, m, grid, work, False) < -1:
             return m
     return -1
+
+
+@njit(cache=True)
+def _pair_spring(x, h, loads, m, row, work):
+    """(depth, smoothing, spring) of contact node m against face row ``row``, the shape
+    (x, h) given: :func:`_depth`'s and the pair's spring k (the module's text; 0 where they
+    are apart or the springs are not set yet)."""
+    depth, smoothing = _depth(x, h, loads, m, row, work)
+    if depth <= -smoothing or loads.spring[m] == 0.0:
+        return depth, smoothing, 0.0
+    N = work[1][0]
+    weight = loads.inverse_mass[m]
+    for a in range(9):
+        weight += N[a] * N[a] * loads.face_inverse_mass[row, a]
+    return depth, smoothing, loads.spring[m] / weight
 
 
 @njit(cache=True)
@@ -311,15 +338,11 @@ def _pair_forces(x, h, loads, m, row, out, work):
     the smoothing width w of touching the push is k (d + w)^2 / (4 w), so that it and its
     derivative are continuous (the static tangent stays consistent and a body resting
     on another has a stiffness before it penetrates); zero below d = -w."""
-    depth, smoothing = _depth(x, h, loads, m, row, work)
+    depth, smoothing, spring = _pair_spring(x, h, loads, m, row, work)
     out[:] = 0.0
-    if depth <= -smoothing or loads.spring[m] == 0.0:  # apart, or the springs not set yet
+    if spring == 0.0:
         return
     N = work[1][0]
-    weight = loads.inverse_mass[m]
-    for a in range(9):
-        weight += N[a] * N[a] * loads.face_inverse_mass[row, a]
-    spring = loads.spring[m] / weight
     push = spring * depth if depth >= smoothing else spring * (depth + smoothing) ** 2 / (4.0 * smoothing)
     normal = work[0][2]
     for i in range(3):
@@ -333,7 +356,7 @@ def _contact_forces(model, shape, loads):
     """Each contact node's face on the current shape into loads.touches (K,) (-1: none)
     and the ten nodes' forces of its contact into loads.touch_forces (K, 10, 3), the
     nodes shared among the threads (each node's contact is its own)."""
-    grid = _grid(shape, loads)
+    grid = _grid(shape, loads, 1.0)
     count = loads.nodes.shape[0]
     chunks = min(count, CHUNKS)
     for c in prange(chunks):
@@ -420,12 +443,91 @@ def item_forces(t, model, shape, loads, out):
 
 
 @njit(cache=True)
+def deepest(t, model, shape, loads):
+    """(item, share): the contact node deepest into the face it touches on the current
+    ``shape``, by the share of the offset between them it has gone through (0: the faces
+    touch; 1: the node on the face's mid-surface); (-1, 0.0) where none touches."""
+    best, share = -1, 0.0
+    if loads.nodes.shape[0] == 0:
+        return best, share
+    _contact_forces(model, shape, loads)
+    work = _work()
+    for m in range(loads.nodes.shape[0]):
+        if loads.touches[m] >= 0:
+            depth, smoothing = _depth(shape.x, shape.h, loads, m, loads.touches[m], work)
+            if depth * TOUCHING / smoothing > share:
+                best, share = m, depth * TOUCHING / smoothing
+    return best, share
+
+
+@njit(cache=True)
+def item_energies(t, model, shape, loads, out):
+    """out (K,): the energy stored in each contact node's spring on the current shape, its
+    push integrated over the depth d: k (d + w)^3 / (12 w) within the smoothing width w,
+    (2/3) k w^2 + k (d^2 - w^2) / 2 past it."""
+    if loads.nodes.shape[0] == 0:
+        return
+    _contact_forces(model, shape, loads)
+    work = _work()
+    for m in range(loads.nodes.shape[0]):
+        out[m] = 0.0
+        if loads.touches[m] < 0:
+            continue
+        depth, w, spring = _pair_spring(shape.x, shape.h, loads, m, loads.touches[m], work)
+        if depth < w:
+            out[m] = spring * (depth + w) ** 3 / (12.0 * w)
+        else:
+            out[m] = spring * (2.0 / 3.0 * w * w + 0.5 * (depth * depth - w * w))
+
+
+@njit(cache=True)
+def item_gaps(t, model, shape, loads, out):
+    """out (K,): each contact node's gap on the current ``shape``, its distance from the
+    nearest face it may touch less the offset (:func:`_depth`'s depth, negated), +inf
+    where none is within :data:`GAP_REACH` times the contact's reach (a clearance of
+    about a thickness)."""
+    if loads.nodes.shape[0] == 0:
+        return
+    grid = _grid(shape, loads, GAP_REACH)
+    work = _work()
+    width, origin = grid
+    for m in range(loads.nodes.shape[0]):
+        y = shape.x[loads.nodes[m]]
+        first, stop = cell_faces(y, width, origin, loads.start)
+        out[m] = np.inf
+        for entry in range(first, stop):
+            row = loads.entries[entry]
+            if _may_touch(loads, m, row, y, True):
+                out[m] = min(out[m], -_depth(shape.x, shape.h, loads, m, row, work)[0])
+
+
+@njit(cache=True)
+def farthest_moved(t, model, shape, loads, before):
+    """(item, share): of the contact nodes that end near a face (a gap of
+    :func:`item_gaps`), the one that moved farthest from its place in ``before`` (n, 3)
+    to the current ``shape``, by the share of its offset (offset times its fibre length,
+    the mid-surfaces' distance when touching) it moved; (-1, 0.0) for none."""
+    best, share = -1, 0.0
+    gaps = np.empty(loads.nodes.shape[0])
+    item_gaps(t, model, shape, loads, gaps)
+    for m in range(loads.nodes.shape[0]):
+        if gaps[m] == np.inf:
+            continue
+        node = loads.nodes[m]
+        moved = np.sqrt((shape.x[node, 0] - before[node, 0]) ** 2 + (shape.x[node, 1] - before[node, 1]) ** 2
+                        + (shape.x[node, 2] - before[node, 2]) ** 2) / (loads.offset[m] * shape.h[node])
+        if moved > share:
+            best, share = m, moved
+    return best, share
+
+
+@njit(cache=True)
 def couplings(t, model, shape, loads, step_u, nodes, blocks):
     """The derivative of each touching pair's forces with respect to its ten nodes'
     translations (central differences of step ``step_u``; the pair and the fibre lengths
     held): nodes (K, 10) the node numbers and blocks (K, 30, 30) dF/dx, filled from the
     top. Returns how many pairs touch."""
-    grid = _grid(shape, loads)
+    grid = _grid(shape, loads, 1.0)
     work = _work()
     plus, minus = np.empty((10, 3)), np.empty((10, 3))
     x = shape.x

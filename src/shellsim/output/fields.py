@@ -33,7 +33,7 @@ CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrang
 #: fibre_1, fibre_2, ...
 FIBRES, FIBRE_PREFIX = "fibres", "fibre_"
 NODAL_SUFFIX = "_nodal"
-CONTACT_PRESSURE = "contact_pressure"
+CONTACT_PRESSURE, CONTACT_GAP = "contact_pressure", "contact_gap"
 #: Fields the shell view shows as their largest value through the thickness (a bent
 #: shell's equivalent stress peaks at its faces); the others as the thickness mean.
 LARGEST_THROUGH_THICKNESS = ("von_mises",)
@@ -41,7 +41,7 @@ LARGEST_THROUGH_THICKNESS = ("von_mises",)
 #: What each field or probe quantity measures, for units in titles and axis labels.
 FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
-              "von_mises": "stress", "contact_pressure": "stress", "time": "time"}
+              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time"}
 #: Units of each kind per deck unit system (meta.units); nothing is converted.
 UNITS = {"SI": {"length": "m", "stress": "Pa", "time": "s"},
          "mm-t-s": {"length": "mm", "stress": "MPa", "time": "s"},
@@ -211,6 +211,9 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
     if CONTACT_PRESSURE in fields:
         point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim, mesh), model.conn, len(mesh.layers))
+    if CONTACT_GAP in fields:
+        gaps = ToolForces(sim.model, []).gaps(sim.state.t, sim.state.fields.shape)
+        point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers))
     if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
         for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),

@@ -185,8 +185,11 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     indices = _frame_indices(frame, len(series.times))
     frames = [series.frame(i) for i in indices]
     picked = [field_values(p, c, field, component) for p, c in frames]
-    low = min(float(v.min()) for v, _, _ in picked)
-    high = max(float(v.max()) for v, _, _ in picked)
+    # NaN marks a value that is not there (a contact gap beyond the search): drawn grey
+    low = min(float(np.nanmin(v, initial=np.inf)) for v, _, _ in picked)
+    high = max(float(np.nanmax(v, initial=-np.inf)) for v, _, _ in picked)
+    if not np.isfinite(low):
+        low = high = 0.0
     if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
         low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
     title, units = _series_units(folder)

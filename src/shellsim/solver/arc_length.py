@@ -109,6 +109,7 @@ class ArcLength:
             # the energy against the work of the force scale over the step: the predictor's own
             # work vanishes at a limit point, where the load's change does
             if newton.converged(norm, scale, energy, scale * length, floor):
+                newton.held_apart(t)
                 self.direction = total[m]
                 self.load_time = t
                 return iteration, norm / max(scale, 1e-300), t - start

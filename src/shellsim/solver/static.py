@@ -18,6 +18,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
+from ..loads import passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, _frame, _record, ending, output_times
@@ -121,6 +122,7 @@ class NewtonSolver:
                 # the energy of the next correction, with the last factorisation
                 energy = abs(float(self.tangent[1].solve(residual) @ residual))
                 if self.converged(norm, scale, energy, first_energy, self.tangent[2]):
+                    self.held_apart(t)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
@@ -144,6 +146,14 @@ class NewtonSolver:
             pending = np.zeros_like(known)
             eq.evaluate(t)
         raise AssertionError("unreachable")
+
+    def held_apart(self, t: float) -> None:
+        """Raises NotConverged when the equilibrium just found at load time t has contact
+        surfaces passed through each other: it is no answer, and a shorter step may find
+        the one that holds them apart."""
+        why = passed_through(self.run.model, t, self.run.sim.state.fields.shape, self.eq.converged.arrays["x"])
+        if why:
+            raise NotConverged(why)
 
     def reach(self, landing: float, length: float) -> tuple[NewtonStep, float]:
         """A converged step from the state's t toward ``landing``, tried at ``length`` (or

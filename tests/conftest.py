@@ -60,18 +60,23 @@ def prepared(deck):
     return prepare(deck, mesh, build_model(deck, mesh))
 
 
-def initial_external_forces(model):
-    """(f, g) (n, 3): the external forces of ``model`` at t = 0 on its initial shape, and
+def initial_shape(model):
+    """A :class:`shellsim.bundles.Shape` of ``model``'s initial state (copies)."""
+    from shellsim.bundles import Shape
+
+    return Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+
+
+def initial_external_forces(model, t: float = 0.0):
+    """(f, g) (n, 3): the external forces of ``model`` at time t on its initial shape, and
     their director-conjugate part (which external_forces turns into rotational forces)."""
     import numpy as np
 
-    from shellsim.bundles import Shape
     from shellsim.loads import external_forces
 
     n = model.n_nodes
     f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
-    shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
-    external_forces(0.0, model, shape, np.zeros((n, 3)), np.zeros((n, 2)), f, fr, g)
+    external_forces(float(t), model, initial_shape(model), np.zeros((n, 3)), np.zeros((n, 2)), f, fr, g)
     return f, g
 
 

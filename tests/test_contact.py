@@ -17,7 +17,7 @@ from shellsim.loads import calibrate, step_share
 from shellsim.model import build_model
 from shellsim.solver.explicit import EXTERNAL, INTERNAL, KINETIC
 
-from .conftest import deck_text, initial_external_forces, run_deck
+from .conftest import deck_text, initial_external_forces, initial_shape, run_deck
 
 PLATE = 'builder = "rectangle"\nlength = 1.0\nwidth = 1.0'
 
@@ -72,13 +72,12 @@ def test_the_gap_to_a_tool_is_the_clearance_of_the_nearest_face_and_its_springs_
     """The plate 0.1 above a plane through z = 0 (h = 0.02): every node's gap is its bottom
     face's height, 0.1 - h/2, and the springs hold nothing; 0.005 below it, the overlap
     -0.015 as a negative gap, and each node's spring k 0.015^2 / 2."""
-    from shellsim.bundles import Shape
     from shellsim.loads import ToolForces
 
     k = 0.1 / (1.0 + 0.01**2)
     for lift, expected in ((0.1, 0.09), (-0.005, -0.015)):
         _, _, _, model = tool_forces('shape = "plane"\nnormal = [0.0, 0.0, 1.0]', lift=lift)
-        shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+        shape = initial_shape(model)
         np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, shape), expected, rtol=1e-12)
         stored = ToolForces(model, ["tool"])(0.0, shape)["tool_energy"]
         assert stored == pytest.approx(model.n_nodes * 0.5 * k * min(expected, 0.0) ** 2, rel=1e-12, abs=1e-300)

@@ -24,7 +24,7 @@ from shellsim.output.fields import contact_pressure, output_mesh
 from shellsim.output.mesh_files import write_mesh_vtu
 from shellsim.solver.explicit import EXTERNAL, INTERNAL, KINETIC
 
-from .conftest import ROOT, deck_text, run_deck
+from .conftest import ROOT, deck_text, initial_shape, run_deck
 
 H = 0.01  # the plates' thickness
 
@@ -239,15 +239,13 @@ def test_the_gap_between_two_plates_is_their_faces_clearance_within_the_search_s
     """Two plates (h = 0.01) with their facing faces ``lift`` apart: every node's gap is
     that clearance (to 1e-12), both ways; 0.05 apart, farther than the gaps are looked
     for (about a thickness), there is none to tell."""
-    from shellsim.bundles import Shape
     from shellsim.model import build_model
 
     text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3, lift).as_posix()}"',
                      '[[contact]]\ntype = "shells"\nname = "between"\nset = "upper"\nagainst = "lower"\n')
     deck = parse_deck(text)
     model = build_model(deck, build_mesh(deck))
-    shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
-    np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, shape), expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, initial_shape(model)), expected, rtol=0, atol=1e-12)
 
 
 def test_the_contact_forces_are_the_derivative_of_the_energy_the_springs_hold(tmp_path):

@@ -14,7 +14,7 @@ from shellsim.geometry import build_mesh
 from shellsim.loads.tool_surface import read_tool, search_grid, signed_distance
 from shellsim.model import build_model
 
-from .conftest import deck_text
+from .conftest import deck_text, initial_external_forces
 from .test_contact import PLATE, tool_forces
 
 
@@ -101,16 +101,12 @@ def test_a_surface_moved_by_a_curve_pushes_from_where_it_is(tmp_path):
     text = deck_text(PLATE, f'[mesh]\ndivisions = {{ length = 2, width = 2 }}\n[[contact]]\ntype = "rigid_tool"\n'
                             f'name = "tool"\n{keys}\ncurve = "lift"\n[curves.lift]\nt = [0.0, 1.0]\n'
                             'value = [0.0, 1.0]\n').replace("thickness = 0.01", "thickness = 0.02")
-    from shellsim.bundles import Shape
-    from shellsim.loads import calibrate, external_forces
+    from shellsim.loads import calibrate
 
     model = build_model(parse_deck(text), build_mesh(parse_deck(text)))
     calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
-    n = model.n_nodes
-    shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
-    f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
     for t, depth in ((0.0, 0.0), (1.0, 0.005)):
-        external_forces(t, model, shape, np.zeros((n, 3)), np.zeros((n, 2)), f, fr, g)
+        f, _ = initial_external_forces(model, t)
         np.testing.assert_allclose(f[:, 2], 0.1 / (1.0 + 0.01**2) * depth, rtol=1e-9, atol=1e-18)
 
 

@@ -76,7 +76,7 @@ def initial_external_forces(model, t: float = 0.0):
 
     n = model.n_nodes
     f, fr, g = np.zeros((n, 3)), np.zeros((n, 2)), np.zeros((n, 3))
-    external_forces(float(t), model, initial_shape(model), np.zeros((n, 3)), np.zeros((n, 2)), f, fr, g)
+    external_forces(float(t), model, initial_shape(model), f, fr, g)
     return f, g
 
 

@@ -168,10 +168,10 @@ class Fields(NamedTuple):
     rotational velocities at the last half step; theta (n, 2) accumulated rotations;
     mt, mr (n,) lumped masses; stress (ne, nq, nt, 5) lamina Cauchy stress (s11, s22,
     s12, s13, s23); f_int, f_ext (n, 3), fr_int, fr_ext (n, 2) forces at t;
-    prescribed_velocity (P,) of the prescribed translations; work (4,) internal,
-    (unused), external and damping work to t; energy (4,) internal work, kinetic energy,
-    external work, damping work at the start of the last step (see
-    :func:`shellsim.solver.explicit.advance`)."""
+    prescribed_velocity (P,) of the prescribed translations; work (5,) internal,
+    (unused), external, damping and friction work to t; energy (5,) internal work,
+    kinetic energy, external, damping and friction work at the start of the last step
+    (see :func:`shellsim.solver.explicit.advance`)."""
 
     shape: Shape
     v: np.ndarray

@@ -1,6 +1,6 @@
 """External loads as registered kinds, one module each, and what the solvers call:
 :func:`build_loads` (the deck's loads as the kernels' tables), the compiled
-:func:`external_forces` and :func:`add_load_tangents`.
+:func:`external_forces` and :func:`friction_forces`, and :class:`LoadTangents`.
 
 A kind is a module of this package with
 - ``TABLES``: its deck tables (:class:`~shellsim.loads.table.LoadTable`, ``type`` their
@@ -265,18 +265,32 @@ _add_every_friction = _every_kind_with("add_friction")
 
 
 @njit(cache=True)
-def external_forces(t, model, shape, v, w, f_ext, fr_ext, g):
+def external_forces(t, model, shape, f_ext, fr_ext, g):
     """External forces at time t of every load of ``model`` (:class:`shellsim.bundles.Model`)
-    on the current ``shape`` moving at the velocities v (n, 3), w (n, 2) (friction's;
-    zeros for none): f_ext (n, 3) translational and fr_ext (n, 2) rotational, both
-    overwritten. g (n, 3): scratch for the director-conjugate forces, so that nothing is
-    allocated per step."""
+    on the current ``shape``, friction's apart (:func:`friction_forces`): f_ext (n, 3)
+    translational and fr_ext (n, 2) rotational, both overwritten. g (n, 3): scratch for
+    the director-conjugate forces, so that nothing is allocated per step."""
     f_ext[:] = 0.0
     g[:] = 0.0
     _add_every_kind(t, model, shape, (f_ext, g))
-    _add_every_friction(t, model, shape, (f_ext, g, v, w))
     # director-conjugate forces act on the rotational DOFs through the fibre frame
     to_rotational(g, shape.d, shape.e1, fr_ext)
+
+
+@njit(cache=True)
+def friction_forces(t, model, shape, v, w, f_fr, fr_fr, g):
+    """The contacts' friction at time t on the current ``shape`` moving at the velocities
+    v (n, 3), w (n, 2), after :func:`external_forces` on the same shape (whose contacts
+    it reads): f_fr (n, 3) and fr_fr (n, 2), overwritten; g (n, 3) scratch."""
+    f_fr[:] = 0.0
+    g[:] = 0.0
+    _add_every_friction(t, model, shape, (f_fr, g, v, w))
+    to_rotational(g, shape.d, shape.e1, fr_fr)
+
+
+def has_friction(model) -> bool:
+    """Whether any contact of ``model`` has friction (a ``friction`` field not all zero)."""
+    return any(np.any(bundle.friction) for _, bundle in _with(model, "add_friction"))
 
 
 class LoadTangents:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..element.sampling import pressure_band, thickness_mean
-from ..element.shape import gauss_rule, shape
+from ..element.shape import NODE_RS, gauss_rule, shape
 from ..materials.laws import LAWS
 from ..mesh import layer_geometry, node_areas
 from ..model import Model
@@ -55,6 +55,11 @@ SUB_BOUNDS = -1.0 + np.concatenate([[0.0], np.cumsum(gauss_rule(3)[1])])
 CORNER_RS = np.array([(r, s) for s in SUB_BOUNDS for r in SUB_BOUNDS])
 #: Shape functions at the corners. Shape (16, 9).
 CORNER_N = shape(CORNER_RS)
+#: Piecewise-bilinear weights at the corners, each from the 2 x 2 nodes of the quarter of
+#: the element it lies in. Shape (16, 9). Never outside those nodes' range: a contact's
+#: pressure, which drops to zero within an element, read through the quadratic would dip
+#: below zero beside it.
+CORNER_HATS = np.prod(np.clip(1.0 - np.abs(CORNER_RS[:, None, :] - NODE_RS[None]), 0.0, None), axis=2)
 #: Corners of the sub-cell of in-plane point q = i_r + 3 i_s (counter-clockwise). Shape (9, 4).
 SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in range(3) for i in range(3))])
 
@@ -93,10 +98,15 @@ class OutputMesh:
         return self.cell_type == "hexahedron"
 
 
-def _at_corners(nodal: np.ndarray, conn: np.ndarray, layers: int) -> np.ndarray:
-    """Nodal values (n, ...) interpolated to the sub-cell corners of each element and
-    repeated on each of ``layers`` corner layers: (ne * layers * 16, ...)."""
-    values = np.einsum("ca,ea...->ec...", CORNER_N, nodal[conn])
+def _at_corners(nodal: np.ndarray, conn: np.ndarray, layers: int, weights: np.ndarray = CORNER_N) -> np.ndarray:
+    """Nodal values (n, ...) interpolated to the sub-cell corners of each element by
+    ``weights`` (16, 9) and repeated on each of ``layers`` corner layers: (ne * layers *
+    16, ...). A NaN (no value) reaches only the corners whose weight on it is not zero."""
+    at_nodes = nodal[conn]
+    missing = np.isnan(at_nodes)
+    values = np.einsum("ca,ea...->ec...", weights, np.where(missing, 0.0, at_nodes))
+    if missing.any():
+        values[np.einsum("ca,ea...->ec...", (weights != 0.0).astype(float), missing.astype(float)) > 0.0] = np.nan
     return np.repeat(values[:, None], layers, axis=1).reshape(-1, *nodal.shape[1:])
 
 
@@ -210,10 +220,11 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
             point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
     if CONTACT_PRESSURE in fields:
-        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim, mesh), model.conn, len(mesh.layers))
+        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim, mesh), model.conn, len(mesh.layers),
+                                                   CORNER_HATS)
     if CONTACT_GAP in fields:
         gaps = ToolForces(sim.model, []).gaps(sim.state.t, sim.state.fields.shape)
-        point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers))
+        point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers), CORNER_HATS)
     if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
         for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),

@@ -7,9 +7,17 @@ import csv
 from pathlib import Path
 
 from ..errors import OutputError
+from ..solver.explicit import FRICTION
 from ..solver.run import Listener, Run
 
-ENERGY_COLUMNS = ("internal_energy", "kinetic_energy", "external_work", "damping_work")
+#: The energies' columns, in the order of :mod:`shellsim.solver.explicit`'s indices; the
+#: last, friction's, only where a contact has friction.
+ENERGY_COLUMNS = ("internal_energy", "kinetic_energy", "external_work", "damping_work", "friction_work")
+
+
+def energy_columns(run: Run) -> tuple[str, ...]:
+    """The energies' columns of ``run``'s history."""
+    return ENERGY_COLUMNS if run.sim.workspace.friction else ENERGY_COLUMNS[:FRICTION]
 
 
 class HistoryWriter(Listener):
@@ -26,9 +34,9 @@ class HistoryWriter(Listener):
 
     def on_sample(self, run: Run) -> None:
         if not self._header_written:
-            self._writer.writerow(["time", "dt", *ENERGY_COLUMNS, *run.history])
+            self._writer.writerow(["time", "dt", *energy_columns(run), *run.history])
             self._header_written = True
-        energy = run.energies[-1]
+        energy = run.energies[-1][:len(energy_columns(run))]
         row = [run.times[-1], run.dt, *energy, *(values[-1] for values in run.history.values())]
         self._writer.writerow([f"{v:.12g}" for v in row])
         self._file.flush()

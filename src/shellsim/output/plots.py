@@ -116,11 +116,15 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
     figure = Figure(figsize=size, layout="constrained")
     ax = figure.subplots()
     t = history["time"]
-    for column, label, style in (("internal_energy", "internal", "-"), ("kinetic_energy", "kinetic", "-"),
-                                 ("external_work", "external work", "--"), ("damping_work", "damping work", "-")):
-        ax.plot(t, history[column], ls=style, label=label)
-    balance = history["internal_energy"] + history["kinetic_energy"] + history["damping_work"] - history["external_work"]
-    ax.plot(t, balance, color="black", ls=":", label="balance (internal + kinetic + damping - external)")
+    # what the structure holds or has lost (friction's only where a contact has friction)
+    kept = [name for name in ("internal_energy", "kinetic_energy", "damping_work", "friction_work")
+            if name in history.dtype.names]
+    for column in kept:
+        ax.plot(t, history[column], label=column.replace("_energy", "").replace("_", " "))
+    ax.plot(t, history["external_work"], ls="--", label="external work")
+    balance = sum(history[column] for column in kept) - history["external_work"]
+    names = " + ".join(column.split("_")[0] for column in kept)
+    ax.plot(t, balance, color="black", ls=":", label=f"balance ({names} - external)")
     ax.set_xlabel(labelled("time", "time", deck.meta.units))
     ax.set_ylabel("energy")
     ax.grid(alpha=0.3)

@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import __version__
 from ..plan import Plan
-from ..solver.explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC
+from ..solver.explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC
 from ..solver.run import Run, dt_statistics
 from ..verify.check import check
 from .folder import write_atomically
@@ -57,6 +57,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "energy": {
             "internal": float(e[INTERNAL]), "kinetic": float(e[KINETIC]),
             "external_work": float(e[EXTERNAL]), "damping_work": float(e[DAMPED]),
+            **({"friction_work": float(e[FRICTION])} if run.sim.workspace.friction else {}),
             "balance_error": run.balance_error,
             "balance_error_percent": 100.0 * run.balance_error / scale,
         },

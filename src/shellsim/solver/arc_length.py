@@ -52,7 +52,7 @@ class LoadRate:
 
     def _forces(self, t: float) -> np.ndarray:
         fields = self.sim.state.fields
-        self._external(float(t), self.sim.model, fields.shape, fields.v, fields.w, self._f, self._fr, self._g)
+        self._external(float(t), self.sim.model, fields.shape, self._f, self._fr, self._g)
         return self.unknowns.gather(self.unknowns.to_local(self._f, self._fr))[:self.unknowns.n_free]
 
     def __call__(self, t: float) -> np.ndarray:

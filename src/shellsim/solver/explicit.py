@@ -10,7 +10,9 @@ Scheme (velocities at half steps, variable step sizes):
     x(n+1) = x(n) + dt(n+1/2) v(n+1/2);  directors rotated by dt(n+1/2) w(n+1/2).
 Constraints act on the velocities (projection), prescribed translations set them.
 Energies: internal and external work by the trapezoidal rule over each step's
-increments, kinetic energy of the half-step velocities, work of the damping forces.
+increments, kinetic energy of the half-step velocities, work of the damping forces, and
+the energy friction takes (the work of the contacts' friction forces, negated, apart from
+the external work).
 """
 
 from __future__ import annotations
@@ -23,29 +25,38 @@ from numba import njit
 from ..curve_tables import factor
 from ..element.assembly import Assembly, assembly, internal_forces
 from ..element.frames import rotate_director
-from ..loads import external_forces
+from ..loads import external_forces, friction_forces, has_friction
 
-#: Indices into the work and energy arrays: internal work, kinetic energy, external work,
-#: damping work.
-INTERNAL, KINETIC, EXTERNAL, DAMPED = range(4)
+#: Indices into the work and energy arrays: internal work, kinetic energy, external work
+#: (friction's apart), damping work, friction work (the energy friction takes out).
+INTERNAL, KINETIC, EXTERNAL, DAMPED, FRICTION = range(5)
+ENERGIES = 5
 
 
 class Workspace(NamedTuple):
     """Scratch of the time loop, allocated once per simulation (n nodes): dx, dd (n, 3)
     the last step's mid-surface and director increments; g (n, 3) director-conjugate
-    external forces; parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`)."""
+    external forces; parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`);
+    friction: whether the contacts have friction, then f_fr (n, 3), fr_fr (n, 2) its
+    forces at t (part of the external ones; (0, 3), (0, 2) without)."""
 
     dx: np.ndarray
     dd: np.ndarray
     g: np.ndarray
     parts: Assembly
+    friction: bool
+    f_fr: np.ndarray
+    fr_fr: np.ndarray
 
 
 def workspace(model) -> Workspace:
     """A :class:`Workspace` for ``model`` (:class:`shellsim.bundles.Model`)."""
     n = model.x0.shape[0]
+    friction = has_friction(model)
+    m = n if friction else 0
     return Workspace(dx=np.zeros((n, 3)), dd=np.zeros((n, 3)), g=np.zeros((n, 3)),
-                     parts=assembly(n, len(model.body.conn)))
+                     parts=assembly(n, len(model.body.conn)), friction=friction,
+                     f_fr=np.zeros((m, 3)), fr_fr=np.zeros((m, 2)))
 
 
 @njit(cache=True)
@@ -54,7 +65,25 @@ def forces(t, model, fields, space):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
     forces of the incremental formulation take the last step's increments from ``space``."""
     internal_forces(model, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int, space.parts)
-    external_forces(t, model, fields.shape, fields.v, fields.w, fields.f_ext, fields.fr_ext, space.g)
+    external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g)
+    if space.friction:
+        friction_forces(t, model, fields.shape, fields.v, fields.w, space.f_fr, space.fr_fr, space.g)
+        f_ext, fr_ext = fields.f_ext, fields.fr_ext
+        f_ext += space.f_fr
+        fr_ext += space.fr_fr
+
+
+@njit(cache=True)
+def half_work(f, fr, dx, w, step):
+    """Half the work of the forces f (n, 3), fr (n, 2) over the translations dx (n, 3)
+    and the rotations step * w (n, 2): one half of the trapezoidal rule."""
+    work = 0.0
+    for node in range(f.shape[0]):
+        for i in range(3):
+            work += 0.5 * f[node, i] * dx[node, i]
+        for j in range(2):
+            work += 0.5 * fr[node, j] * step * w[node, j]
+    return work
 
 
 @njit(cache=True)
@@ -73,8 +102,8 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     updated in place; space: a :class:`Workspace`. On entry the forces in ``fields``
     must be those at time t; on return they are those at the returned time. ``dt_prev``
     is the previous step (0 before the first step, which makes it the start-up half
-    step). ``fields.work`` (4,) accumulates internal, external and damping work to the
-    current time; ``fields.energy`` (4,) is the balance at the start of the last step
+    step). ``fields.work`` (5,) accumulates internal, external, damping and friction work
+    (indexed as :data:`INTERNAL` ...) to the current time; ``fields.energy`` (5,) is the balance at the start of the last step
     taken, whose kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences
     conserve exactly with the trapezoidal works (a linear undamped system keeps
     internal + kinetic - external constant to round-off). Returns (t, dt_prev, steps).
@@ -97,6 +126,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
         c = damping * dt_avg
         work_ext = 0.0
         work_int = 0.0
+        work_fr = 0.0
         kinetic = 0.0
         for node in range(n):
             # translations: velocity update, constraint projection
@@ -126,6 +156,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
         energy[KINETIC] = kinetic
         energy[EXTERNAL] = work[EXTERNAL]
         energy[DAMPED] = work[DAMPED]
+        energy[FRICTION] = work[FRICTION]
         for node in range(n):
             for i in range(3):
                 dx[node, i] = step * v[node, i]
@@ -144,8 +175,12 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
             for j in range(2):
                 work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
                 work_int += 0.5 * fr_int[node, j] * step * w[node, j]
+        if space.friction:
+            work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
         t += step
         forces(t, model, fields, space)
+        if space.friction:
+            work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
         damped = 0.0
         for node in range(n):
             for i in range(3):
@@ -157,8 +192,9 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
                 work_int += 0.5 * fr_int[node, j] * step * w[node, j]
                 damped += damping * mr[node] * w[node, j] * w[node, j] * step
         work[INTERNAL] += work_int
-        work[EXTERNAL] += work_ext
+        work[EXTERNAL] += work_ext - work_fr  # the friction forces are among the external ones
         work[DAMPED] += damped
+        work[FRICTION] -= work_fr
         dt_prev = step
         steps += 1
         if not np.isfinite(work_int + work_ext + kinetic):

@@ -26,7 +26,7 @@ from ..mesh import Mesh
 from ..model import Model
 from .probes import Probe, probe_value, resolve_probes
 from ..signals import STOP_SIGNALS, handling
-from .explicit import DAMPED, EXTERNAL, INTERNAL, KINETIC, equal_step
+from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
@@ -73,9 +73,9 @@ class Run:
 
     @property
     def balance_error(self) -> float:
-        """(internal + kinetic + damping - external) energy now."""
+        """(internal + kinetic + damping + friction - external) energy now."""
         e = self.sim.state.energy
-        return float(e[INTERNAL] + e[KINETIC] + e[DAMPED] - e[EXTERNAL])
+        return float(e[INTERNAL] + e[KINETIC] + e[DAMPED] + e[FRICTION] - e[EXTERNAL])
 
 
 class Listener:
@@ -226,7 +226,7 @@ def _update_time_step(run: Run, listener: Listener) -> None:
 def _check_stability(run: Run) -> None:
     s = run.sim.state
     e = s.energy
-    scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC] + e[DAMPED])
+    scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC] + e[DAMPED] + abs(e[FRICTION]))
     broken = not (np.isfinite(s.x).all() and np.isfinite(e).all())
     if not broken and scale > ENERGY_FLOOR * max(abs(e[EXTERNAL]), 1e-300):
         broken = abs(run.balance_error) > UNSTABLE_BALANCE * scale and run.balance_error > 0

@@ -57,8 +57,8 @@ class Simulation:
             shape=shape, v=np.zeros((n, 3)), w=np.zeros((n, 2)), theta=np.zeros((n, 2)),
             mt=np.zeros(n), mr=np.zeros(n), stress=np.zeros((ne, nq, nt, 5)),
             f_int=np.zeros((n, 3)), fr_int=np.zeros((n, 2)), f_ext=np.zeros((n, 3)), fr_ext=np.zeros((n, 2)),
-            prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(4),
-            energy=np.zeros(4)))
+            prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(explicit.ENERGIES),
+            energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
                                  stiffness=TypedCall(stiffness_product))

@@ -35,7 +35,8 @@ and, when it has kernels of its own,
   ``deepest(t, model, shape, bundle)``, (item, share) the contact node that has gone
   deepest through the offset between the surfaces and by what share of it, and
   ``farthest_moved(t, model, shape, bundle, before)``, of those near a face the one that
-  moved farthest since the positions ``before`` (n, 3), by what share of its offset;
+  moved farthest relative to it since the positions ``before`` (n, 3), by what share of
+  its distance from the face;
 - where its forces couple nodes that share no element (contact between shells):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
@@ -135,11 +136,13 @@ def step_share(model) -> float:
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)
 
 
-#: The share of its offset a contact node may go through, or move in one load step, in
-#: an equilibrium: a node deeper has passed through (a load step too long for the
-#: penalty, or a penalty too soft to hold the surfaces apart); one that moved farther may
-#: have passed a face unseen (a node against face contact measures no side), and the
-#: state answers nothing. Half: no node can reach a face's mid-surface in one step.
+#: The share of its offset a contact node may go through in an equilibrium, and of its
+#: distance from the nearest face's mid-surface it may move relative to that face in one
+#: load step: a node deeper has passed through (a load step too long for the penalty, or
+#: a penalty too soft to hold the surfaces apart); one that moved farther may have passed
+#: the face unseen (a node against face contact measures no side), and the state answers
+#: nothing. Half: a node that crossed a mid-surface in the step has moved at least its
+#: distance from it.
 PASSED_THROUGH = 0.5
 
 
@@ -150,8 +153,8 @@ def passed_through(model, t: float, shape: Shape, before: np.ndarray) -> str | N
     for kind, bundle in _with(model, "deepest"):
         item, share = kind.farthest_moved(float(t), model, shape, bundle, before)
         if share > PASSED_THROUGH:
-            return (f"contact node {bundle.nodes[item] + 1} (numbered from 1) moved {share:.2g} times its offset "
-                    f"between the surfaces in one load step, far enough to pass through a face unseen")
+            return (f"contact node {bundle.nodes[item] + 1} (numbered from 1) moved {share:.2g} times its distance "
+                    f"from the nearest face, relative to it, in one load step: far enough to pass through it unseen")
         item, share = kind.deepest(float(t), model, shape, bundle)
         if share > PASSED_THROUGH:
             return (f"contact node {bundle.nodes[item] + 1} (numbered from 1) has gone {share:.0%} of the way through "

@@ -483,6 +483,23 @@ def item_energies(t, model, shape, loads, out):
 
 
 @njit(cache=True)
+def _nearest_face(shape, loads, m, grid, work):
+    """(row, gap): the face nearest contact node m of those it may touch within the reach
+    of ``grid`` (:func:`_grid`), and the node's gap to it (-1, +inf for none)."""
+    width, origin = grid
+    y = shape.x[loads.nodes[m]]
+    first, stop = cell_faces(y, width, origin, loads.start)
+    nearest, gap = -1, np.inf
+    for entry in range(first, stop):
+        row = loads.entries[entry]
+        if _may_touch(loads, m, row, y, True):
+            depth = _depth(shape.x, shape.h, loads, m, row, work)[0]
+            if -depth < gap:
+                nearest, gap = row, -depth
+    return nearest, gap
+
+
+@njit(cache=True)
 def item_gaps(t, model, shape, loads, out):
     """out (K,): each contact node's gap on the current ``shape``, its distance from the
     nearest face it may touch less the offset (:func:`_depth`'s depth, negated), +inf
@@ -492,34 +509,40 @@ def item_gaps(t, model, shape, loads, out):
         return
     grid = _grid(shape, loads, GAP_REACH)
     work = _work()
-    width, origin = grid
     for m in range(loads.nodes.shape[0]):
-        y = shape.x[loads.nodes[m]]
-        first, stop = cell_faces(y, width, origin, loads.start)
-        out[m] = np.inf
-        for entry in range(first, stop):
-            row = loads.entries[entry]
-            if _may_touch(loads, m, row, y, True):
-                out[m] = min(out[m], -_depth(shape.x, shape.h, loads, m, row, work)[0])
+        out[m] = _nearest_face(shape, loads, m, grid, work)[1]
 
 
 @njit(cache=True)
 def farthest_moved(t, model, shape, loads, before):
-    """(item, share): of the contact nodes that end near a face (a gap of
-    :func:`item_gaps`), the one that moved farthest from its place in ``before`` (n, 3)
-    to the current ``shape``, by the share of its offset (offset times its fibre length,
-    the mid-surfaces' distance when touching) it moved; (-1, 0.0) for none."""
+    """(item, share): of the contact nodes that end near a face (within the reach of
+    :func:`item_gaps`), the one that moved farthest relative to the nearest face's
+    nearest point, from their places in ``before`` (n, 3) to the current ``shape``, by
+    the share of its distance from that face's mid-surface (the offset when touching) it
+    moved; (-1, 0.0) for none. A node passing through the face would have moved more
+    than that distance: parts that move together (a strip's neighbouring elements
+    rolling up) count nothing."""
     best, share = -1, 0.0
-    gaps = np.empty(loads.nodes.shape[0])
-    item_gaps(t, model, shape, loads, gaps)
+    if loads.nodes.shape[0] == 0:
+        return best, share
+    grid = _grid(shape, loads, GAP_REACH)
+    work = _work()
+    moved = np.empty(3)
     for m in range(loads.nodes.shape[0]):
-        if gaps[m] == np.inf:
+        row, gap = _nearest_face(shape, loads, m, grid, work)
+        if row < 0:
             continue
+        depth, smoothing = _depth(shape.x, shape.h, loads, m, row, work)
+        N = work[1][0]  # the shape functions at the face's nearest point
         node = loads.nodes[m]
-        moved = np.sqrt((shape.x[node, 0] - before[node, 0]) ** 2 + (shape.x[node, 1] - before[node, 1]) ** 2
-                        + (shape.x[node, 2] - before[node, 2]) ** 2) / (loads.offset[m] * shape.h[node])
-        if moved > share:
-            best, share = m, moved
+        for i in range(3):
+            moved[i] = shape.x[node, i] - before[node, i]
+            for a in range(9):
+                moved[i] -= N[a] * (shape.x[loads.faces[row, a], i] - before[loads.faces[row, a], i])
+        distance = gap + smoothing / TOUCHING  # from the face's mid-surface
+        relative = np.sqrt(moved[0] ** 2 + moved[1] ** 2 + moved[2] ** 2) / distance
+        if relative > share:
+            best, share = m, relative
     return best, share
 
 

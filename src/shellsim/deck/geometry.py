@@ -176,6 +176,60 @@ class Hemisphere(Section):
         return sets | _points("pole")
 
 
+class AorticValve(Section):
+    """The three leaflets of an aortic valve, axis along z, in a near-closed position:
+    each a structured patch between its attachment to the root and its free edge,
+    commissure to commissure. The free edges run at height ``height`` along the lines
+    from the commissures to the axis, each kept ``gap`` / 2 from the plane between two
+    leaflets (so neighbours start ``gap`` apart: more than a thickness, or their faces
+    would overlap and never be held apart by contact); the ``coaptation_height`` below
+    them hangs vertically, the band where closed leaflets meet. Each leaflet hangs from a
+    vertical commissure post at radius ``commissure_radius`` on either side, from the free
+    edge down to half the band's lower edge's height, and from the attachment on the root
+    that runs from there down to ``base_radius`` at z = 0 under the leaflet's centre; its
+    belly leaves the root horizontally, turning up into the coaptation band (a quadratic
+    in each section from the root to the band, the sections commissure to commissure,
+    each spaced evenly along its length). Leaflet k is centred at 90 + 120 k degrees from x.
+    Defaults: the mid-diastolic proportions Rb / Rc = 1.2 and H / Rc = 1.4 (Thubrikar,
+    Piepgrass, Shaner & Nolan 1981, Am. J. Physiol. 241:H795) for a commissure radius of
+    10 (mm).
+
+    Sets: surfaces ``leaflet_1`` .. ``leaflet_3``; edges ``attachment`` (the root's line
+    and the commissures', all three leaflets), ``free_edge`` (all three),
+    ``free_edge_1`` .. ``free_edge_3``; points ``centre_1`` .. ``centre_3`` (the free
+    edges' middles, nearest the axis) and ``nadir_1`` .. ``nadir_3`` (the attachments'
+    lowest points). Cell vectors ``along_free_edge``: each element's direction
+    commissure to commissure, for ``material.axes = { kind = "mesh", field =
+    "along_free_edge" }`` (a leaflet's collagen runs parallel to its free edge).
+    Divisions ``around`` (per leaflet, commissure to commissure; even) x ``belly`` x
+    ``coaptation``.
+    """
+
+    builder: Literal["aortic_valve"]
+    commissure_radius: Positive = 10.0
+    base_radius: Positive = 12.0
+    height: Positive = 14.0
+    coaptation_height: Positive = 2.0
+    gap: Positive = 0.5
+    DIVISIONS: ClassVar[dict[str, int]] = {"around": 8, "belly": 4, "coaptation": 1}
+    LEAFLETS: ClassVar[int] = 3
+
+    def sets(self) -> SetKinds:
+        leaflets = range(1, self.LEAFLETS + 1)
+        return ({f"leaflet_{k}": "surface" for k in leaflets} | _edges("attachment", "free_edge")
+                | _edges(*(f"free_edge_{k}" for k in leaflets))
+                | _points(*(f"{name}_{k}" for name in ("centre", "nadir") for k in leaflets)))
+
+    @model_validator(mode="after")
+    def _proportions(self) -> "AorticValve":
+        if self.height <= self.coaptation_height:
+            raise ValueError(f"height = {self.height:g} must exceed coaptation_height = {self.coaptation_height:g}: "
+                             "the band hangs from the free edge at that height")
+        if self.gap >= self.commissure_radius:
+            raise ValueError(f"gap = {self.gap:g} must be smaller than commissure_radius = {self.commissure_radius:g}")
+        return self
+
+
 #: File endings read as triangulated surfaces, remeshed into quads.
 SURFACE_SUFFIXES = (".stl", ".obj", ".ply", ".vtp", ".off")
 
@@ -215,7 +269,7 @@ class MeshFile(Section):
 Geometry = Annotated[
     Union[
         Rectangle, CylindricalPanel, TwistedStrip, AnnularSector, PlateWithHole, Tube,
-        Hemisphere, MeshFile,
+        Hemisphere, AorticValve, MeshFile,
     ],
     Field(discriminator="builder"),
 ]
@@ -225,7 +279,7 @@ BUILDERS = {
     tag_of(cls)[1]: cls
     for cls in (
         Rectangle, CylindricalPanel, TwistedStrip, AnnularSector, PlateWithHole, Tube,
-        Hemisphere, MeshFile,
+        Hemisphere, AorticValve, MeshFile,
     )
 }
 

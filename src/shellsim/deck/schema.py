@@ -486,6 +486,11 @@ class Deck(Section):
                 f"mesh.divisions.around: the tube is built from two 45-degree patches, so it "
                 f"must be even, got {self.mesh.divisions['around']}"
             )
+        if self.geometry.builder == "aortic_valve" and self.mesh.divisions.get("around", 2) % 2:
+            problems.append(
+                f"mesh.divisions.around: must be even so that each free edge's middle is a node, "
+                f"got {self.mesh.divisions['around']}"
+            )
         if self.geometry.builder == "twisted_strip" and self.mesh.divisions.get("width", 2) % 2:
             problems.append(
                 f"mesh.divisions.width: must be even so the tip centre is a node, "

@@ -65,9 +65,8 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
             hint = builders.BUILDERS[g.builder](sketch, g, deck.mesh, deck.section.thickness)
             sketch.finish()
             x, conn, sets, surface_normals = extract(gmsh, source)
-        if g.builder == "twisted_strip":
-            x, normals = builders.twist_onto_helicoid(x, g)
-            surface_normals = [(np.arange(len(x)), normals)]
+        if g.builder in builders.MAPPED:  # meshed flat, its nodes mapped onto the surface
+            x, surface_normals, cell_vectors = builders.MAPPED[g.builder](x, conn, g)
         preferred = hint(x[conn[:, 8]])
     if g.builder == "file":  # a builder makes the sets its deck model declares (tested)
         problems = check_references(deck, {name: s.kind for name, s in sets.items()})

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..deck.geometry import (
-    AnnularSector, CylindricalPanel, Hemisphere, PlateWithHole, Rectangle, Tube, TwistedStrip,
+    AnnularSector, AorticValve, CylindricalPanel, Hemisphere, PlateWithHole, Rectangle, Tube, TwistedStrip,
 )
 from ..deck.schema import MeshOptions
 
@@ -156,17 +156,18 @@ def twisted_strip(sk: Sketch, g: TwistedStrip, mesh: MeshOptions, thickness: flo
     return hint
 
 
-def twist_onto_helicoid(x: np.ndarray, g: TwistedStrip) -> tuple[np.ndarray, np.ndarray]:
-    """Map flat-strip positions (x, w, 0) to (x, w cos a, w sin a), a = twist x / length.
+def twist_onto_helicoid(x: np.ndarray, conn: np.ndarray, g: TwistedStrip) -> tuple[np.ndarray, list, dict]:
+    """Map flat-strip positions (x, w, 0) (n, 3) to (x, w cos a, w sin a), a = twist x / length.
 
-    Returns the mapped positions (n, 3) and the helicoid's unit normals there (n, 3):
-    (x_,x) cross (x_,w) = (-w a', -sin a, cos a), a' = twist / length.
+    Returns the mapped positions (n, 3), the helicoid's unit normals there as every
+    node's surface normals, (x_,x) cross (x_,w) = (-w a', -sin a, cos a), a' = twist /
+    length, and no cell vectors.
     """
     rate = math.radians(g.twist_deg) / g.length
     a, w = rate * x[:, 0], x[:, 1]
     mapped = np.column_stack([x[:, 0], w * np.cos(a), w * np.sin(a)])
     normal = np.column_stack([-w * rate, -np.sin(a), np.cos(a)])
-    return mapped, normal / np.linalg.norm(normal, axis=1, keepdims=True)
+    return mapped, [(np.arange(len(x)), normal / np.linalg.norm(normal, axis=1, keepdims=True))], {}
 
 
 def annular_sector(sk: Sketch, g: AnnularSector, mesh: MeshOptions, thickness: float) -> Hint:
@@ -314,6 +315,104 @@ def tube(sk: Sketch, g: Tube, mesh: MeshOptions, thickness: float) -> Hint:
     return outward
 
 
+def aortic_valve(sk: Sketch, g: AorticValve, mesh: MeshOptions, thickness: float) -> Hint:
+    """Meshed flat here, leaflet k (from 0) as the unit square at x = 2k (x the way from
+    commissure to commissure, y from the attachment to the free edge, the coaptation
+    band above y = 1/2), in four patches so that the middles are points;
+    :func:`onto_valve` maps the nodes afterwards."""
+    half, n_belly, n_band = mesh.divisions["around"] // 2, mesh.divisions["belly"], mesh.divisions["coaptation"]
+    for k in range(g.LEAFLETS):
+        rows = [[sk.point((2 * k + 0.5 * i, y, 0.0)) for i in range(3)] for y in (0.0, 0.5, 1.0)]
+        surfaces = []
+        for (low, high), n in (((0, 1), n_belly), ((1, 2), n_band)):
+            for i in range(2):
+                a, b, c, d = rows[low][i], rows[low][i + 1], rows[high][i + 1], rows[high][i]
+                surfaces.append(sk.patch([sk.line(a, b, half), sk.line(b, c, n), sk.line(c, d, half),
+                                          sk.line(d, a, n)], flat=True))
+        sk.name(2, f"leaflet_{k + 1}", surfaces)
+        root = [sk.line(rows[0][i], rows[0][i + 1], half) for i in range(2)]
+        sides = [sk.line(rows[j][i], rows[j + 1][i], n) for i in (0, 2) for j, n in ((0, n_belly), (1, n_band))]
+        sk.name(1, "attachment", root + sides)
+        free = [sk.line(rows[2][i], rows[2][i + 1], half) for i in range(2)]
+        sk.name(1, "free_edge", free)
+        sk.name(1, f"free_edge_{k + 1}", free)
+        sk.name(0, f"centre_{k + 1}", [rows[2][1]])
+        sk.name(0, f"nadir_{k + 1}", [rows[0][1]])
+
+    def aortic_side(x: np.ndarray) -> np.ndarray:
+        """Up and out toward the leaflet's own sinus: e_k + z."""
+        centre = np.radians(90.0 + 120.0 * _leaflet_of(x))
+        return np.column_stack([np.cos(centre), np.sin(centre), np.ones(len(x))])
+
+    return aortic_side
+
+
+def _leaflet_of(x: np.ndarray) -> np.ndarray:
+    """(n,) the leaflet (0, 1, 2) whose sector holds each mapped position (n, 3)."""
+    angle = np.degrees(np.arctan2(x[:, 1], x[:, 0]))
+    return np.round((angle - 90.0) / 120.0).astype(int) % 3
+
+
+def valve_points(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Positions (n, 3) on leaflet k (n,) at u (n,) in [0, 1] from commissure to
+    commissure and y (n,) in [0, 1] from the attachment (0) over the belly to the
+    coaptation band (1/2) and the free edge (1) (:class:`AorticValve`)."""
+    half, rc, rb, cc = 0.5 * g.gap, g.commissure_radius, g.base_radius, g.coaptation_height
+    centre = np.radians(90.0 + 120.0 * k)
+    # the free edge: two straight branches gap / 2 off the planes between leaflets
+    first = u <= 0.5
+    branch = centre + np.where(first, -1.0, 1.0) * np.pi / 3.0
+    inward = branch + np.where(first, 0.5, -0.5) * np.pi  # toward the leaflet's centre line
+    s_commissure, s_apex = math.sqrt(rc**2 - half**2), half / (2.0 * math.cos(math.pi / 6.0))
+    s = np.where(first, s_commissure + (s_apex - s_commissure) * 2.0 * u,
+                 s_apex + (s_commissure - s_apex) * (2.0 * u - 1.0))
+    free = np.column_stack([s * np.cos(branch) + half * np.cos(inward), s * np.sin(branch) + half * np.sin(inward),
+                            np.full(len(u), g.height)])
+    band_foot = free - [0.0, 0.0, cc]
+    # the attachment, from half the band foot's height under the commissures down to z = 0 mid-leaflet
+    offset = math.asin(half / rc)
+    around = (centre - np.pi / 3.0 + offset) + (2.0 * np.pi / 3.0 - 2.0 * offset) * u
+    w = np.sin(np.pi * u)
+    radius = rc + (rb - rc) * w
+    attached = np.column_stack([radius * np.cos(around), radius * np.sin(around), 0.5 * (g.height - cc) * (1.0 - w)])
+    points = band_foot + (2.0 * y - 1.0)[:, None] * (free - band_foot)
+    belly = y < 0.5
+    control = np.column_stack([band_foot[:, :2], attached[:, 2]])  # leaves the root flat, meets the band upright
+    points[belly] = _evenly_along(attached[belly], control[belly], band_foot[belly], 2.0 * y[belly])
+    return points
+
+
+def _evenly_along(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray, share: np.ndarray) -> np.ndarray:
+    """The points (n, 3) ``share`` (n,) of the way along each quadratic Bezier p0, p1, p2
+    (n, 3), by arc length (a root's control point may sit on p0, which bunches the
+    parameter there)."""
+    t = np.linspace(0.0, 1.0, 257)
+    curve = ((1 - t)[None, :, None] ** 2 * p0[:, None] + 2 * (t * (1 - t))[None, :, None] * p1[:, None]
+             + t[None, :, None] ** 2 * p2[:, None])  # (n, T, 3)
+    length = np.concatenate([np.zeros((len(p0), 1)),
+                             np.cumsum(np.linalg.norm(np.diff(curve, axis=1), axis=2), axis=1)], axis=1)
+    out = np.empty_like(p0)
+    for i in range(len(p0)):
+        at = np.interp(share[i] * length[i, -1], length[i], t)
+        out[i] = (1 - at) ** 2 * p0[i] + 2 * at * (1 - at) * p1[i] + at**2 * p2[i]
+    return out
+
+
+def onto_valve(x: np.ndarray, conn: np.ndarray, g: AorticValve) -> tuple[np.ndarray, list, dict]:
+    """Flat leaflet positions (n, 3) (:func:`aortic_valve`) mapped onto the valve; no
+    exact normals (the directors average the elements'); cell vectors
+    ``along_free_edge`` (ne, 3): each element's unit direction of growing u at its centre."""
+    k = np.floor(x[:, 0] / 2.0 + 0.25).astype(int)
+    u, y = np.clip(x[:, 0] - 2.0 * k, 0.0, 1.0), np.clip(x[:, 1], 0.0, 1.0)
+    mapped = valve_points(g, k, u, y)
+    c = conn[:, 8]
+    step = 1e-6
+    along = (valve_points(g, k[c], np.minimum(u[c] + step, 1.0), y[c])
+             - valve_points(g, k[c], np.maximum(u[c] - step, 0.0), y[c]))
+    return mapped, [], {"along_free_edge": along / np.linalg.norm(along, axis=1, keepdims=True)}
+
+
+
 BUILDERS = {
     "rectangle": rectangle,
     "cylindrical_panel": cylindrical_panel,
@@ -322,4 +421,10 @@ BUILDERS = {
     "plate_with_hole": plate_with_hole,
     "tube": tube,
     "hemisphere": hemisphere,
+    "aortic_valve": aortic_valve,
 }
+
+#: Builders that mesh flat and map the nodes onto their surface: (positions (n, 3), conn,
+#: geometry) -> (mapped positions, surface normals as for :func:`combine_surface_normals`,
+#: cell vectors by name).
+MAPPED = {"twisted_strip": twist_onto_helicoid, "aortic_valve": onto_valve}

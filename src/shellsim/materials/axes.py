@@ -108,7 +108,8 @@ class MeshAxes(TurnedAxes):
     def preferred(self, position: np.ndarray, cell_vectors: dict) -> np.ndarray:
         """The element's vector ``field`` at each of its points."""
         if self.field not in cell_vectors:
-            there = ", ".join(f"'{n}'" for n in cell_vectors) or "none (only a mesh file's cell data can give them)"
+            there = ", ".join(f"'{n}'" for n in cell_vectors) or ("none (a mesh file's cell data gives them, and the "
+                                                                    "aortic valve builder 'along_free_edge')")
             raise MeshError(f"material.axes.field = '{self.field}': the mesh has no per-element vectors of that "
                             f"name; it has {there}")
         return np.broadcast_to(cell_vectors[self.field][:, None], position.shape)

@@ -186,7 +186,8 @@ class AorticValve(Section):
     them hangs vertically, the band where closed leaflets meet. Each leaflet hangs from a
     vertical commissure post at radius ``commissure_radius`` on either side, from the free
     edge down to half the band's lower edge's height, and from the attachment on the root
-    that runs from there down to ``base_radius`` at z = 0 under the leaflet's centre; its
+    that runs from there, leaving the posts level (so the leaflet's corners there are
+    square), down to ``base_radius`` at z = 0 under the leaflet's centre; its
     belly leaves the root horizontally, turning up into the coaptation band (a quadratic
     in each section from the root to the band, the sections commissure to commissure,
     each spaced evenly along its length). Leaflet k is centred at 90 + 120 k degrees from x.

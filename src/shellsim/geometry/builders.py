@@ -372,7 +372,7 @@ def valve_points(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) ->
     # the attachment, from half the band foot's height under the commissures down to z = 0 mid-leaflet
     offset = math.asin(half / rc)
     around = (centre - np.pi / 3.0 + offset) + (2.0 * np.pi / 3.0 - 2.0 * offset) * u
-    w = np.sin(np.pi * u)
+    w = np.sin(np.pi * u) ** 2  # level at the posts: the leaflet's corners there are square
     radius = rc + (rb - rc) * w
     attached = np.column_stack([radius * np.cos(around), radius * np.sin(around), 0.5 * (g.height - cc) * (1.0 - w)])
     points = band_foot + (2.0 * y - 1.0)[:, None] * (free - band_foot)

@@ -532,7 +532,7 @@ def farthest_moved(t, model, shape, loads, before):
         row, gap = _nearest_face(shape, loads, m, grid, work)
         if row < 0:
             continue
-        depth, smoothing = _depth(shape.x, shape.h, loads, m, row, work)
+        smoothing = _depth(shape.x, shape.h, loads, m, row, work)[1]  # again: the search left another face's
         N = work[1][0]  # the shape functions at the face's nearest point
         node = loads.nodes[m]
         for i in range(3):

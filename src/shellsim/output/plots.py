@@ -13,6 +13,7 @@ from ..deck.resolved import read_resolved
 from ..errors import OutputError
 from .fields import labelled
 from .folder import output_folder
+from .history import ENERGY_COLUMNS
 
 PLOTS_DIR = "plots"
 #: How each reference measure is drawn: as points on the curve, or as a level.
@@ -116,9 +117,8 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
     figure = Figure(figsize=size, layout="constrained")
     ax = figure.subplots()
     t = history["time"]
-    # what the structure holds or has lost (friction's only where a contact has friction)
-    kept = [name for name in ("internal_energy", "kinetic_energy", "damping_work", "friction_work")
-            if name in history.dtype.names]
+    # what the structure holds or has lost: every energy column the history has but the external work
+    kept = [name for name in ENERGY_COLUMNS if name != "external_work" and name in history.dtype.names]
     for column in kept:
         ax.plot(t, history[column], label=column.replace("_energy", "").replace("_", " "))
     ax.plot(t, history["external_work"], ls="--", label="external work")

@@ -29,8 +29,8 @@ from ..loads import external_forces, friction_forces, has_friction
 
 #: Indices into the work and energy arrays: internal work, kinetic energy, external work
 #: (friction's apart), damping work, friction work (the energy friction takes out).
-INTERNAL, KINETIC, EXTERNAL, DAMPED, FRICTION = range(5)
 ENERGIES = 5
+INTERNAL, KINETIC, EXTERNAL, DAMPED, FRICTION = range(ENERGIES)
 
 
 class Workspace(NamedTuple):
@@ -103,8 +103,8 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     must be those at time t; on return they are those at the returned time. ``dt_prev``
     is the previous step (0 before the first step, which makes it the start-up half
     step). ``fields.work`` (5,) accumulates internal, external, damping and friction work
-    (indexed as :data:`INTERNAL` ...) to the current time; ``fields.energy`` (5,) is the balance at the start of the last step
-    taken, whose kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences
+    (indexed as :data:`INTERNAL` ...) to the current time; ``fields.energy`` (5,) is the
+    balance at the start of the last step taken, whose kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences
     conserve exactly with the trapezoidal works (a linear undamped system keeps
     internal + kinetic - external constant to round-off). Returns (t, dt_prev, steps).
     """

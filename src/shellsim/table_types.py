@@ -31,6 +31,15 @@ Vec3 = tuple[Real, Real, Real]
 Name = Annotated[str, Field(strict=True, pattern=r"^[A-Za-z][A-Za-z0-9_\-]*$")]
 
 
+def need_directions(table: BaseModel, *keys: str) -> None:
+    """Raises ValueError naming the first of ``keys`` whose vector on ``table`` is zero
+    (an absent one, None, passes)."""
+    for key in keys:
+        vector = getattr(table, key)
+        if vector is not None and not any(vector):
+            raise ValueError(f"{key} = {list(vector)} has no direction; give a nonzero vector")
+
+
 def repeated(names: list[str]) -> list[str]:
     """The names that occur more than once in ``names``, sorted."""
     return sorted({name for name in names if names.count(name) > 1})

@@ -82,6 +82,7 @@ def deck_reference() -> str:
     lines += _table(schema.Output, "## [output]")
     lines += _table(schema.Probe, "## [[output.probe]]")
     lines += _table(schema.Render, "## [[output.render]]")
+    lines += _table(schema.Valve, "## [output.valve]")
     lines += _table(schema.Reference, "## [reference] (one) or [[reference]] (several)")
     return "\n".join(lines).rstrip() + "\n"
 

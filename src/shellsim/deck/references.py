@@ -90,12 +90,22 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
                 problems.append(f"contact[{i}].name: '{column}' is already a history column (a probe's, a curve's "
                                 "load factor or a contact's); choose another name")
             columns.append(column)
+    valve = deck.output.valve
+    if valve is not None:
+        need_set("output.valve.leaflets", valve.leaflets, ("surface",))
+        need_set("output.valve.annulus", valve.annulus, ("edge", "point"))
+        for column in valve.COLUMNS:
+            if column in columns:
+                problems.append(f"output.valve: its history column '{column}' is already a probe's, a curve's load "
+                                "factor's or a contact's; rename that one")
+            columns.append(column)
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)
         if probe.name in factors:
             problems.append(f"output.probe[{i}].name: '{probe.name}' is the history's column of a curve's load "
                             "factor; choose another name")
     probes = [p.name for p in deck.output.probe] + factors + measure_names([c.name for c in deck.contact])
+    probes += list(valve.COLUMNS) if valve is not None else []
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:
             problems.append(

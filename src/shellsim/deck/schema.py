@@ -7,7 +7,7 @@ deck (defaults filled) is what the program runs.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
@@ -16,7 +16,7 @@ from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
 from ..loads import CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
-from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, repeated
+from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, need_directions, repeated
 
 Axis = Literal["x", "y", "z"]
 
@@ -297,10 +297,7 @@ class Probe(Section):
             )
         if (self.component == "along") != (self.direction is not None):
             raise ValueError("'direction' is needed with component = 'along', and only then")
-        for key in ("axis", "direction"):
-            vector = getattr(self, key)
-            if vector is not None and not any(vector):
-                raise ValueError(f"{key} = {list(vector)} has no direction; give a nonzero vector")
+        need_directions(self, "axis", "direction")
         return self
 
 
@@ -326,6 +323,42 @@ class Render(Section):
         return field
 
 
+class Valve(Section):
+    """``[output.valve]``: a valve's measures in history.csv (columns ``orifice_area``,
+    ``regurgitant_gap``, ``coaptation_area``, ``coaptation_height``,
+    ``peak_principal_stress``) and their final, smallest and largest values in
+    summary.json, for the ``leaflets`` (a surface set) hanging from the ``annulus`` (an edge
+    set), the valve's ``axis`` pointing downstream.
+
+    ``orifice_area``: the geometric orifice area, the inside of the annulus seen along the
+    axis that no leaflet's solid covers (read on a raster of ``resolution`` pixels across
+    the annulus: to about half a pixel along the orifice's edge); ``regurgitant_gap``: the
+    widest opening, the diameter of the largest disc that fits through the orifice (0 when
+    shut; to about a pixel); ``coaptation_area``: half the leaflets' surface carrying
+    contact force (each pair of coapting surfaces once); ``coaptation_height``: the extent
+    along the axis of the nodes in contact within a quarter of the annulus radius of the
+    axis, where the leaflets meet in the middle; ``peak_principal_stress``: the largest
+    principal Cauchy stress at the leaflets' integration points, every layer. A
+    measurement costs a raster and a stress evaluation, so it is taken at ``samples``
+    evenly spaced times (the history samples between hold nan in its columns)."""
+
+    #: The measures' history columns, each with what it measures (for units).
+    COLUMNS: ClassVar[dict[str, str]] = {"orifice_area": "area", "regurgitant_gap": "length",
+                                         "coaptation_area": "area", "coaptation_height": "length",
+                                         "peak_principal_stress": "stress"}
+
+    leaflets: Name = "all"
+    annulus: Name
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    resolution: int = Field(default=400, ge=50, le=10000)
+    samples: int = Field(default=200, ge=1, le=100000)
+
+    @model_validator(mode="after")
+    def _axis_has_direction(self) -> "Valve":
+        need_directions(self, "axis")
+        return self
+
+
 class Output(Section):
     """``[output]``: frames at t = 0 and every ``interval`` (or at the listed ``times``,
     which the time stepper lands on exactly) and at the end; the ``fields`` written in
@@ -334,7 +367,7 @@ class Output(Section):
     frames/); ``solid`` writes the shell as a solid between its faces instead of its
     mid-surface; ``mirror`` writes the model whole, reflected across the planes of its
     ``symmetry`` boundaries (a quarter tube as eight copies with a z symmetry plane);
-    probes (history.csv) and renders."""
+    probes (history.csv), a valve's measures and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
@@ -344,6 +377,7 @@ class Output(Section):
     mirror: bool = False
     probe: list[Probe] = []
     render: list[Render] = []
+    valve: Valve | None = None
 
     @model_validator(mode="after")
     def _one_schedule(self) -> "Output":

@@ -34,7 +34,7 @@ from pydantic import model_validator
 from ..curve_tables import factor, rate
 from ..element.frames import cross
 from ..element.tangent import moved_node
-from ..table_types import Name, Positive, Vec3
+from ..table_types import Name, Positive, Vec3, need_directions
 from .table import ContactTable
 from .tool_surface import read_tool, search_grid, signed_distance
 
@@ -82,10 +82,7 @@ class RigidTool(ContactTable):
             raise ValueError(f"shape = '{self.shape}' takes {', '.join(needs)}"
                              + (f"; missing {', '.join(missing)}" if missing else "")
                              + (f"; {', '.join(extra)} is not for it" if extra else ""))
-        for key in ("normal", "axis"):
-            vector = getattr(self, key)
-            if vector is not None and not any(vector):
-                raise ValueError(f"{key} = {list(vector)} has no direction; give a nonzero vector")
+        need_directions(self, "normal", "axis")
         if self.shape == "plane" and self.side != "outside":
             raise ValueError("a plane keeps the shell on its normal's side; give the normal that way round")
         return self

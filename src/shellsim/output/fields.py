@@ -43,10 +43,10 @@ FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "leng
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
               "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time"}
 #: Units of each kind per deck unit system (meta.units); nothing is converted.
-UNITS = {"SI": {"length": "m", "stress": "Pa", "time": "s"},
-         "mm-t-s": {"length": "mm", "stress": "MPa", "time": "s"},
-         "mm-kg-ms": {"length": "mm", "stress": "GPa", "time": "ms"},
-         "in-lbf-s": {"length": "in", "stress": "psi", "time": "s"},
+UNITS = {"SI": {"length": "m", "area": "m^2", "stress": "Pa", "time": "s"},
+         "mm-t-s": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
+         "mm-kg-ms": {"length": "mm", "area": "mm^2", "stress": "GPa", "time": "ms"},
+         "in-lbf-s": {"length": "in", "area": "in^2", "stress": "psi", "time": "s"},
          "consistent": {}}
 
 #: Sub-cell boundaries along r or s: the 3-point Gauss weights laid end to end.

@@ -1,5 +1,5 @@
-"""Line plots of a finished run (matplotlib, no display needed): each probe's history
-against time, and against the load when one load follows a time curve (load-displacement
+"""Line plots of a finished run (matplotlib, no display needed): each probe's and valve
+measure's history against time, and against the load when one load follows a time curve (load-displacement
 curves such as the thesis' Figures 4.29 and 4.33), with the deck's references drawn on
 them; and the energies."""
 
@@ -44,7 +44,7 @@ def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
 
 
 def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
-    """PNGs of every probe's history (``<probe>.png``) and of the energies
+    """PNGs of every probe's and valve measure's history (``<name>.png``) and of the energies
     (``energy.png``) in ``out_dir`` (default ``folder/plots``). Returns the files written.
     Text from the deck is drawn as written: a '$' in a title is not TeX to parse."""
     from matplotlib import rc_context
@@ -61,21 +61,23 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
     times = history["time"]
     load = _load_axis(deck, times)
     written = []
-    for probe in deck.output.probe:
-        values = history[probe.name]
+    valve = deck.output.valve.COLUMNS if deck.output.valve is not None else {}
+    for name, quantity in [(probe.name, probe.quantity) for probe in deck.output.probe] + list(valve.items()):
+        measured = ~np.isnan(history[name])  # a valve's measures are taken at some samples only
+        t, values = times[measured], history[name][measured]
         figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")
         axes = figure.subplots(1, 2 if load else 1, squeeze=False)[0]
-        ylabel = labelled(probe.name, probe.quantity, deck.meta.units)
-        for ax, x, xlabel in zip(axes, (times, *(load[:1] if load else ())),
+        ylabel = labelled(name, quantity, deck.meta.units)
+        for ax, x, xlabel in zip(axes, (t, *((load[0][measured],) if load else ())),
                                  (labelled("time", "time", deck.meta.units), *(load[1:] if load else ()))):
             ax.plot(x, values, color="black", lw=1.4, label="shellsim")
-            _draw_references(ax, deck, probe.name, times, x)
+            _draw_references(ax, deck, name, t, x)
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
         figure.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", fontsize="small", ncols=2)
         figure.suptitle(deck.meta.title, fontsize="medium")
-        written.append(_save(figure, out_dir / f"{probe.name}.png"))
+        written.append(_save(figure, out_dir / f"{name}.png"))
     written.append(_plot_energy(deck, history, out_dir / "energy.png", size))
     return written
 

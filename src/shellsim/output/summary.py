@@ -1,5 +1,5 @@
 """summary.json: what was run, how long it took, the energy balance, what the scene used
-and left out, and each reference check."""
+and left out, a valve's measures and each reference check."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from .. import __version__
 from ..plan import Plan
 from ..solver.explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC
 from ..solver.run import Run, dt_statistics
+from ..solver.valve import VALVE_COLUMNS
 from ..verify.check import check
 from .folder import write_atomically
 
@@ -65,6 +66,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         **large_strain,
         **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
         **({"contact": contact_record(run, output_seconds)} if run.tool_forces is not None else {}),
+        **({"valve": valve_record(run)} if run.valve is not None else {}),
         "reference": reference_results(run),
     }
 
@@ -86,6 +88,18 @@ def contact_record(run: Run, output_seconds: float) -> dict:
     record = {"us_per_evaluation": 1e6 * per_evaluation}
     if run.deck.solver.method == "explicit" and run.sim.state.steps:
         record["share_of_step"] = per_evaluation * run.sim.state.steps / max(run.wall_time - output_seconds, 1e-300)
+    return record
+
+
+def valve_record(run: Run) -> dict:
+    """Each valve measure's last, smallest and largest value over the samples measured
+    (None for all three when none was)."""
+    record = {}
+    for column in VALVE_COLUMNS:
+        values = np.asarray(run.history[column])
+        measured = values[~np.isnan(values)]
+        record[column] = ({"final": float(measured[-1]), "min": float(measured.min()), "max": float(measured.max())}
+                          if len(measured) else dict.fromkeys(("final", "min", "max")))
     return record
 
 

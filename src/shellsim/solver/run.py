@@ -30,6 +30,7 @@ from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
+from .valve import VALVE_COLUMNS, ValveMeasures, resolve_valve
 
 #: History samples over a run (fewer when the run has fewer steps).
 HISTORY_SAMPLES = 2000
@@ -64,6 +65,7 @@ class Run:
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
     load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
     tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
+    valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS
 
     @property
     def load_time(self) -> float:
@@ -147,7 +149,7 @@ class Timed(Listener):
 
 
 def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
-    """A run ready to start: simulation built, probes resolved, contact springs set from
+    """A run ready to start: simulation built, probes and a valve's measures resolved, contact springs set from
     the masses and the structure's critical step (:func:`shellsim.loads.calibrate`)."""
     probes = resolve_probes(deck.output.probe, mesh, model)
     run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
@@ -161,6 +163,9 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
         calibrate(model, s.mt, s.mr, run.sim.critical_time_step())
         run.sim.evaluate_forces()  # the springs act from the start
         run.tool_forces = ToolForces(model, names)
+    run.valve = resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)
+    if run.valve is not None:
+        run.history |= {column: [] for column in VALVE_COLUMNS}
     return run
 
 
@@ -188,6 +193,10 @@ def _record(run: Run, listener: Listener) -> None:
     if run.tool_forces is not None:
         for name, force in run.tool_forces(run.load_time, run.sim.state.fields.shape).items():
             run.history[name].append(force)
+    if run.valve is not None:
+        due = run.valve.due(run.sim.state.t)
+        for name, value in (run.valve(run.sim) if due else dict.fromkeys(VALVE_COLUMNS, math.nan)).items():
+            run.history[name].append(value)
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
 

@@ -109,6 +109,16 @@ def test_a_step_above_the_critical_one_is_stopped_with_a_clear_message():
         run_deck(deck)
 
 
+def test_a_scene_that_waits_unloaded_is_not_taken_for_unstable():
+    """The heartbeat valve's first 2 ms, unloaded (its waveform is zero through ejection):
+    the built leaflets move by round-off alone, energies of 1e-32 with no external work to
+    measure them by, which is no instability (it was taken for one after 16 steps); the
+    balance is not judged, nor shown, until the energies outgrow round-off."""
+    run = run_deck(variant_deck(ROOT / "decks" / "valves" / "aortic_valve_cycle.toml", {"solver.end_time": 0.002}))
+    assert run.status == "completed" and run.sim.state.steps > 100
+    assert run.balance_share() is None
+
+
 def test_an_unstable_run_keeps_what_it_wrote(tmp_path):
     deck = tmp_path / "unstable.toml"
     deck.write_text(PLATE.read_text().replace("[solver]\n", "[solver]\ndt_safety_factor = 0.8\n"))

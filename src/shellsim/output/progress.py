@@ -58,11 +58,10 @@ class ProgressDisplay(Listener):
                     "balance": f"{step.iterations} iterations ({step.tangents} tangents), residual {step.residual:.2g}",
                     "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
         elapsed = max(time.perf_counter() - self.started, 1e-9)
-        e = run.sim.state.energy
-        scale = max(abs(e[2]), 1e-300)
+        share = run.balance_share()
         return {"t": f"{run.sim.state.t:.4g}", "dt": f"{run.dt:.3g}",
                 "rate": f"{run.sim.state.steps / elapsed:,.0f}",
-                "balance": f"{100 * run.balance_error / scale:+.2f}%",
+                "balance": "-" if share is None else f"{100 * share:+.2f}%",
                 "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
 
     def on_sample(self, run: Run) -> None:

@@ -92,6 +92,19 @@ def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     return f"{base}\n[geometry]\n{geometry}\n{extra}"
 
 
+def problems_of(text: str) -> str:
+    """The message a deck of ``text`` is refused with (read as 'broken.toml', which the
+    message names first)."""
+    from shellsim.deck import parse_deck
+    from shellsim.errors import DeckError
+
+    with pytest.raises(DeckError) as caught:
+        parse_deck(text, name="broken.toml")
+    message = str(caught.value)
+    assert message.startswith("broken.toml:")
+    return message
+
+
 @pytest.fixture
 def scene():
     """Parse a deck built by :func:`deck_text`."""

@@ -15,7 +15,7 @@ from shellsim.deck import deck_from_data, load_deck, parse_deck
 from shellsim.deck.curves import Curve
 from shellsim.errors import DeckError
 
-from .conftest import DECKS, deck_text
+from .conftest import DECKS, deck_text, problems_of
 
 RECTANGLE = 'builder = "rectangle"\nlength = 2.0\nwidth = 1.0'
 
@@ -24,14 +24,6 @@ RECTANGLE = 'builder = "rectangle"\nlength = 2.0\nwidth = 1.0'
 def test_every_shipped_deck_validates(path):
     deck = load_deck(path)
     assert deck.meta.title
-
-
-def problems_of(text: str) -> str:
-    with pytest.raises(DeckError) as caught:
-        parse_deck(text, name="broken.toml")
-    message = str(caught.value)
-    assert message.startswith("broken.toml:")
-    return message
 
 
 @pytest.mark.parametrize(

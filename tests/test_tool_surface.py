@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from shellsim.deck import parse_deck
-from shellsim.errors import DeckError, MeshError
+from shellsim.errors import MeshError
 from shellsim.geometry import build_mesh
 from shellsim.loads.tool_surface import read_tool, search_grid, signed_distance
 from shellsim.model import build_model
 
-from .conftest import deck_text, initial_external_forces
+from .conftest import deck_text, initial_external_forces, problems_of
 from .test_contact import PLATE, tool_forces
 
 
@@ -116,9 +116,7 @@ def test_a_surface_moved_by_a_curve_pushes_from_where_it_is(tmp_path):
     ('shape = "surface"\nfile = "nowhere.stl"', "contact[0].file: file 'nowhere.stl' not found"),
 ])
 def test_a_surface_tool_the_deck_cannot_have_is_named(keys, expected):
-    with pytest.raises(DeckError) as caught:
-        parse_deck(deck_text(PLATE, f'[[contact]]\ntype = "rigid_tool"\nname = "tool"\n{keys}\n'))
-    assert expected in str(caught.value)
+    assert expected in problems_of(deck_text(PLATE, f'[[contact]]\ntype = "rigid_tool"\nname = "tool"\n{keys}\n'))
 
 
 @pytest.mark.parametrize(("triangles", "expected"), [

@@ -12,11 +12,10 @@ import pytest
 
 from shellsim.deck import parse_deck
 from shellsim.deck.schema import Valve
-from shellsim.errors import DeckError
 from shellsim.mesh import NamedSet
 from shellsim.solver.valve import fill_triangles, largest_principal, resolve_valve
 
-from .conftest import deck_text, prepared, run_deck
+from .conftest import deck_text, prepared, problems_of, run_deck
 from .test_shell_contact import H, pressed_plates
 
 PLATE = 'builder = "rectangle"\nlength = 1.0\nwidth = 1.0'
@@ -144,15 +143,12 @@ annulus = "x1"
     ('annulus = "attachment"\naxis = [0.0, 0.0, 0.0]', "axis = [0.0, 0.0, 0.0] has no direction"),
 ])
 def test_a_valve_table_naming_what_the_scene_lacks_is_refused(table, expected):
-    with pytest.raises(DeckError) as error:
-        parse_deck(deck_text(VALVE, f"[output.valve]\n{table}\n"))
-    assert expected in str(error.value)
+    assert expected in problems_of(deck_text(VALVE, f"[output.valve]\n{table}\n"))
 
 
 def test_a_probe_named_like_a_valve_measure_is_refused():
     probe = '[[output.probe]]\nname = "orifice_area"\nquantity = "displacement"\nset = "centre_1"\ncomponent = "z"\n'
-    with pytest.raises(DeckError, match="'orifice_area' is already a probe's"):
-        parse_deck(deck_text(VALVE, probe + VALVE_OUTPUT))
+    assert "'orifice_area' is already a probe's" in problems_of(deck_text(VALVE, probe + VALVE_OUTPUT))
 
 
 def test_the_largest_principal_value_is_eigvalsh_s_largest():

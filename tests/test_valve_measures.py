@@ -158,3 +158,11 @@ def test_the_largest_principal_value_is_eigvalsh_s_largest():
     tensors = np.concatenate([tensors + tensors.transpose(0, 2, 1),
                               [np.diag([2.0, 2.0, 2.0]), np.diag([3.0, 1.0, 1.0]), np.diag([1.0, 3.0, 3.0])]])
     np.testing.assert_allclose(largest_principal(tensors), np.linalg.eigvalsh(tensors)[:, -1], rtol=0, atol=1e-12)
+
+
+def test_a_state_with_no_numbers_measures_nothing_rather_than_failing():
+    """A run breaking down reaches the history sample before its stability check: the
+    measures are nan then, and the check names the breakdown."""
+    run = prepared(parse_deck(deck_text(VALVE, VALVE_OUTPUT)))
+    run.sim.state.x[0] = np.nan
+    assert all(math.isnan(value) for value in run.valve(run.sim).values())

@@ -66,8 +66,11 @@ class ValveMeasures:
 
     def __call__(self, sim) -> dict[str, float]:
         """The measures now in ``sim`` (a :class:`shellsim.solver.simulation.Simulation`),
-        by column name: see :class:`shellsim.deck.schema.Valve`."""
+        by column name: see :class:`shellsim.deck.schema.Valve`; nan for each while the
+        positions are no numbers (a run breaking down, its stability check next)."""
         state, conn = sim.state, sim.model.conn[self.elements]
+        if not np.isfinite(state.x).all():
+            return dict.fromkeys(VALVE_COLUMNS, math.nan)
         open_pixels, pixel = self.opening(state.x, state.d, state.h, conn)
         forces = self.contact.at_nodes(state.t, state.fields.shape)
         leaflet_nodes = np.unique(conn)

@@ -19,9 +19,15 @@ from .folder import write_atomically
 
 
 def reference_results(run: Run) -> list[dict]:
-    """One entry per [reference] of the deck, from the recorded probe histories."""
+    """One entry per [reference] of the deck, from the recorded histories: a valve
+    measure's from the samples it was taken at."""
     times = np.asarray(run.times)
-    return [check(ref, times, np.asarray(run.history[ref.probe])) for ref in run.deck.reference]
+    results = []
+    for ref in run.deck.reference:
+        values = np.asarray(run.history[ref.probe])
+        taken = ~np.isnan(values) if ref.probe in VALVE_COLUMNS else slice(None)
+        results.append(check(ref, times[taken], values[taken]))
+    return results
 
 
 def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, output_seconds: float = 0.0) -> dict:

@@ -1,7 +1,7 @@
 """Line plots of a finished run (matplotlib, no display needed): each probe's and valve
-measure's history against time, and against the load when one load follows a time curve (load-displacement
-curves such as the thesis' Figures 4.29 and 4.33), with the deck's references drawn on
-them; and the energies."""
+measure's history against time, and against the load when one load follows a time curve
+(load-displacement curves such as the thesis' Figures 4.29 and 4.33), with the deck's
+references drawn on them; and the energies."""
 
 from __future__ import annotations
 

@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -83,6 +84,11 @@ class Run:
         e = self.sim.state.energy
         return float(e[INTERNAL] + e[KINETIC] + e[DAMPED] + e[FRICTION] - e[EXTERNAL])
 
+    @cached_property
+    def size(self) -> float:
+        """The model's largest extent along an axis, initially."""
+        return float(np.ptp(self.model.x0, axis=0).max())
+
     def balance_share(self) -> float | None:
         """The balance error over the energies' scale (the external work or what the
         structure holds and has lost, the larger); None while the energies are round-off:
@@ -90,8 +96,7 @@ class Run:
         (its mass times the square of its size over the critical step)."""
         s, e = self.sim.state, self.sim.state.energy
         scale = max(abs(e[EXTERNAL]), e[INTERNAL] + e[KINETIC] + e[DAMPED] + abs(e[FRICTION]))
-        size = float(np.ptp(self.model.x0, axis=0).max())
-        noise = ROUND_OFF * float(s.mt.sum()) * (size / self.dt_critical) ** 2 if self.dt_critical > 0.0 else 0.0
+        noise = ROUND_OFF * float(s.mt.sum()) * (self.size / self.dt_critical) ** 2 if self.dt_critical > 0.0 else 0.0
         if not scale > max(ENERGY_FLOOR * abs(e[EXTERNAL]), noise):
             return None
         return self.balance_error / scale

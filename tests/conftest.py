@@ -87,6 +87,40 @@ def run_deck(deck):
     return solve(prepared(deck))
 
 
+#: The thickness of the plates :func:`pressed_plates` presses together.
+PLATE_THICKNESS = 0.01
+
+
+def pressed_plates(path: Path, p: float, method: str):
+    """The upper of :func:`shellsim.bench.stacked_plates` (3 x 3 over 4 x 4, thickness PLATE_THICKNESS)
+    pushed onto the clamped lower one by a pressure p, in-plane motion held; solved statically or explicitly with
+    damping until it settles."""
+    from shellsim.bench import stacked_plates
+    from shellsim.deck import parse_deck
+
+    solver = ('[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }' if method == "static"
+              else "[solver]\nend_time = 1.0\ndamping = 50.0")
+    text = deck_text(f'builder = "file"\npath = "{stacked_plates(path, 4, 3, thickness=PLATE_THICKNESS).as_posix()}"', f'''
+[[boundary]]
+type = "clamped"
+set = "lower"
+[[boundary]]
+type = "fixed"
+set = "upper"
+translations = ["x", "y"]
+[[load]]
+type = "pressure"
+set = "upper"
+value = {-p}
+[[contact]]
+type = "shells"
+name = "between"
+set = "upper"
+against = "lower"
+''').replace("[solver]\nend_time = 1.0", solver)
+    return run_deck(parse_deck(text))
+
+
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     """A valid deck: ``base`` + [geometry] body + extra tables."""
     return f"{base}\n[geometry]\n{geometry}\n{extra}"

@@ -8,7 +8,6 @@ use."""
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,9 +24,8 @@ from shellsim.output.fields import contact_pressure, output_mesh
 from shellsim.output.mesh_files import write_mesh_vtu
 from shellsim.solver.explicit import EXTERNAL, INTERNAL, KINETIC
 
-from .conftest import ROOT, deck_text, initial_shape, run_deck
-
-H = 0.01  # the plates' thickness
+from .conftest import PLATE_THICKNESS as H
+from .conftest import ROOT, deck_text, initial_shape, pressed_plates, run_deck
 
 
 def test_the_nearest_point_of_a_curved_face_is_the_nearest_of_a_fine_sampling():
@@ -54,33 +52,6 @@ def test_the_nearest_point_of_a_curved_face_is_the_nearest_of_a_fine_sampling():
         sampled = np.linalg.norm(samples - y, axis=1).min()
         assert distance <= sampled + 1e-12
         assert sampled - distance <= np.hypot(distance, stretch) - distance
-
-
-def pressed_plates(path: Path, p: float, method: str):
-    """The upper of :func:`shellsim.bench.stacked_plates` (3 x 3 over 4 x 4, thickness H)
-    pushed onto the clamped lower one by a pressure p, in-plane motion held; solved statically or explicitly with
-    damping until it settles."""
-    solver = ('[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }' if method == "static"
-              else "[solver]\nend_time = 1.0\ndamping = 50.0")
-    text = deck_text(f'builder = "file"\npath = "{stacked_plates(path, 4, 3).as_posix()}"', f'''
-[[boundary]]
-type = "clamped"
-set = "lower"
-[[boundary]]
-type = "fixed"
-set = "upper"
-translations = ["x", "y"]
-[[load]]
-type = "pressure"
-set = "upper"
-value = {-p}
-[[contact]]
-type = "shells"
-name = "between"
-set = "upper"
-against = "lower"
-''').replace("[solver]\nend_time = 1.0", solver)
-    return run_deck(parse_deck(text))
 
 
 @pytest.mark.parametrize("method", ["static", "explicit"])

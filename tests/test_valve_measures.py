@@ -15,8 +15,7 @@ from shellsim.deck.schema import Valve
 from shellsim.mesh import NamedSet
 from shellsim.solver.valve import fill_triangles, largest_principal, resolve_valve
 
-from .conftest import deck_text, prepared, problems_of, run_deck
-from .test_shell_contact import H, pressed_plates
+from .conftest import PLATE_THICKNESS, deck_text, pressed_plates, prepared, problems_of, run_deck
 
 PLATE = 'builder = "rectangle"\nlength = 1.0\nwidth = 1.0'
 
@@ -94,12 +93,12 @@ def test_two_plates_pressed_together_coapt_over_one_plate_s_area_one_thickness_h
     """The contact patch test's plates (a 3 x 3 plate pressed by p onto a 4 x 4 one, every
     node of both touching): the coaptation area is one plate's, 1.0 (each pair of
     coapting surfaces once), and the coaptation height along their normal the
-    mid-surfaces' separation, the thickness H, within the penalty's give (1e-3 H)."""
+    mid-surfaces' separation, the plates' thickness H, within the penalty's give (1e-3 H)."""
     run = pressed_plates(tmp_path / "plates.vtu", 0.01, "static")
     run.mesh.sets["rim"] = _rim(run.mesh)
     measures = resolve_valve(Valve(annulus="rim"), run.mesh, run.model, 1.0)(run.sim)
     assert measures["coaptation_area"] == pytest.approx(1.0, rel=1e-12)
-    assert measures["coaptation_height"] == pytest.approx(H, rel=1e-3)
+    assert measures["coaptation_height"] == pytest.approx(PLATE_THICKNESS, rel=1e-3)
 
 
 def test_a_strip_in_uniaxial_tension_peaks_at_the_pulling_stress():

@@ -38,7 +38,7 @@ CENTRAL = 0.25
 class ValveMeasures:
     """Where the valve measures read.
 
-    elements : (m,) the leaflets' elements; annulus : (k,) the annulus nodes in order
+    elements : (m,) the leaflets' elements; nodes : their nodes; annulus : (k,) the annulus nodes in order
     around the axis; frame : (3, 3) rows e1, e2 across the axis and the axis; resolution :
     the raster's pixels across the annulus; areas : (n,) each node's share of the initial
     mid-surface; radius : the annulus' mean initial distance from its centre, across the
@@ -47,6 +47,7 @@ class ValveMeasures:
     """
 
     elements: np.ndarray
+    nodes: np.ndarray
     annulus: np.ndarray
     frame: np.ndarray
     resolution: int
@@ -73,8 +74,7 @@ class ValveMeasures:
             return dict.fromkeys(VALVE_COLUMNS, math.nan)
         open_pixels, pixel = self.opening(state.x, state.d, state.h, conn)
         forces = self.contact.at_nodes(state.t, state.fields.shape)
-        leaflet_nodes = np.unique(conn)
-        touching = leaflet_nodes[np.linalg.norm(forces[leaflet_nodes], axis=1) > 0.0]
+        touching = self.nodes[np.linalg.norm(forces[self.nodes], axis=1) > 0.0]
         cauchy = sim.point_tensors(self.elements)[1]
         return {
             "orifice_area": float(open_pixels.sum() * pixel**2),
@@ -194,7 +194,8 @@ def resolve_valve(table: ValveTable | None, mesh: Mesh, model: Model, end_time: 
     nodes = mesh.sets[table.annulus].nodes
     across = (model.x0[nodes] - model.x0[nodes].mean(axis=0)) @ frame[:2].T
     order = np.argsort(np.arctan2(across[:, 1], across[:, 0]))
-    return ValveMeasures(elements=mesh.sets[table.leaflets].elements, annulus=nodes[order], frame=frame,
+    elements = mesh.sets[table.leaflets].elements
+    return ValveMeasures(elements=elements, nodes=np.unique(model.conn[elements]), annulus=nodes[order], frame=frame,
                          resolution=table.resolution, areas=node_areas(model.x0, model.conn),
                          radius=float(np.linalg.norm(across, axis=1).mean()), every=end_time / table.samples,
                          contact=ToolForces(model, []))

@@ -50,13 +50,14 @@ def pytest_configure(config):
         warm_numba_cache()
 
 
-def prepared(deck):
-    """A run of ``deck`` ready to start: mesh, model and simulation built."""
+def prepared(deck, base_dir: Path | None = None):
+    """A run of ``deck`` ready to start: mesh (a mesh file's path relative to ``base_dir``),
+    model and simulation built."""
     from shellsim.geometry import build_mesh
     from shellsim.model import build_model
     from shellsim.solver.run import prepare
 
-    mesh = build_mesh(deck)
+    mesh = build_mesh(deck, base_dir)
     return prepare(deck, mesh, build_model(deck, mesh))
 
 
@@ -80,11 +81,11 @@ def initial_external_forces(model, t: float = 0.0):
     return f, g
 
 
-def run_deck(deck):
+def run_deck(deck, base_dir: Path | None = None):
     """``deck`` run to its end time (or solved statically over it)."""
     from shellsim.execute import solve
 
-    return solve(prepared(deck))
+    return solve(prepared(deck, base_dir))
 
 
 #: The thickness of the plates :func:`pressed_plates` presses together.

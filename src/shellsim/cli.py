@@ -157,6 +157,37 @@ def mesh(
     _announce(written)
 
 
+@app.command("import")
+@reports_errors
+def import_model(
+    model: Annotated[Path, typer.Argument(help="Model file: Abaqus input (.inp).", show_default=False)],
+    out_dir: Annotated[Path | None, typer.Option("--out", help="Folder for deck.toml and the mesh [default: the "
+                                                              "model's name].")] = None,
+) -> None:
+    """Bring a model made with another program over as an editable deck and its mesh:
+    shells as 9-node quads with their sets and material axes, and the material, section,
+    supports, loads, contact, amplitudes and first step as deck tables. What has no
+    counterpart is listed (and written at the top of the deck), never dropped silently."""
+    from .foreign.writing import import_model as bring_over
+
+    folder = output_folder(out_dir or Path(model.stem))
+    with err.status(f"reading {model}"):
+        done = bring_over(model, folder)
+    sets = ", ".join(f"{name} ({kind})" for name, kind in sorted(done.sets.items()))
+    out.print(f"{escape(str(model))}: {done.elements} elements; sets: {escape(sets) or 'none'}", highlight=False)
+    if done.unmapped:
+        err.print("[yellow]not brought over[/] (listed at the top of the deck too):")
+        for line in done.unmapped:
+            err.print(f"  - {escape(line)}", highlight=False)
+    _announce([done.deck, done.mesh])
+    if done.problems:
+        err.print(f"[yellow]{done.deck} needs editing before it runs:[/]")
+        for line in done.problems:
+            err.print(f"  - {escape(line)}", highlight=False)
+    else:
+        out.print(f"[green]ok[/] shellsim check {done.deck}; shellsim run {done.deck}")
+
+
 def _announce(paths: Any) -> None:
     """One 'wrote PATH' line per file written."""
     for path in paths:

@@ -15,6 +15,7 @@ import numpy as np
 from .bundles import Body, Constraints, Curves, Material, Model, Prescribed, Rule, Shape, slots_by_node
 from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
+from .errors import MeshError
 from .element.frames import initial_fibre_frame
 from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
@@ -165,6 +166,15 @@ def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:
     return np.column_stack([np.ones(len(rs)), rs])
 
 
+def _point_field(mesh: Mesh, name: str, user: str) -> np.ndarray:
+    """The mesh's scalar point field ``name`` (n,); MeshError naming ``user`` and the fields
+    there are when it has none of that name."""
+    if name not in mesh.point_fields:
+        known = ", ".join(f"'{f}'" for f in sorted(mesh.point_fields)) or "none (only a mesh file carries fields)"
+        raise MeshError(f"{user}: field '{name}' is not a scalar point field of the mesh; it has {known}")
+    return mesh.point_fields[name]
+
+
 def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarray]:
     """The supports as :class:`~shellsim.bundles.Constraints`, and the initial fibre frames
     (n, 3) turned so that a director constraint is one rotational DOF."""
@@ -186,10 +196,11 @@ def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarra
             directions, plane, fixed = [np.asarray(bc.normal)], np.asarray(bc.normal), False
         else:  # prescribed
             directions, plane, fixed = [axes[AXES[bc.translation]]], None, False
+            share = np.ones(n) if bc.field is None else _point_field(mesh, bc.field, f"boundary set '{bc.set}'")
             for node in nodes:
                 prescribed["nodes"].append(node)
                 prescribed["axes"].append(AXES[bc.translation])
-                prescribed["values"].append(bc.value)
+                prescribed["values"].append(bc.value * share[node])
                 prescribed["curves"].append(deck.curve_index(bc.curve))
         for node in nodes:
             constrained[node].extend(directions)

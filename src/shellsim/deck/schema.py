@@ -126,13 +126,16 @@ class Symmetry(Section):
 
 
 class Prescribed(Section):
-    """A global translation prescribed as ``value * curve(t)``."""
+    """A global translation prescribed as ``value * curve(t)``, or as ``value * field *
+    curve(t)`` with ``field`` the name of a scalar point field of the mesh file (each
+    node's own motion, as a model brought over from another program gives it)."""
 
     type: Literal["prescribed"]
     set: Name
     translation: Axis
     value: Real
     curve: Name | None = None
+    field: Name | None = None
 
 
 Boundary = Annotated[Union[Clamped, Fixed, Symmetry, Prescribed], Field(discriminator="type")]

@@ -52,11 +52,16 @@ class ImportedMesh:
 
 
 def read_mesh(path: Path) -> ImportedMesh:
-    """Read a quad9 mesh and its named sets; nodes not used by any quad are dropped.
+    """Read a quad9 mesh and its named sets; nodes not used by any quad are dropped. A model
+    file of another program (:data:`shellsim.foreign.READERS`) gives its shells' mesh.
 
     Raises MeshError, naming every defect with ids and places, for a file that is not a
     quad9 shell mesh or whose nodes, directors, thicknesses or elements cannot be used.
     """
+    from ..foreign import READERS, read_foreign_mesh
+
+    if Path(path).suffix.lower() in READERS:
+        return read_foreign_mesh(Path(path))
     m = read_meshio(Path(path))
     blocks = [i for i, block in enumerate(m.cells) if block.type == "quad9"]
     others = sorted({b.type for b in m.cells if b.type in _NOT_QUAD9})

@@ -13,14 +13,16 @@ from ..geometry.importing import KIND_CODE, SET_PREFIX
 from ..mesh import Mesh
 
 
-def write_mesh_vtu(mesh: Mesh, path: Path) -> None:
+def write_mesh_vtu(mesh: Mesh, path: Path, with_thickness: bool = True) -> None:
     """Write ``mesh`` to ``path`` (.vtu). Each named set becomes a point-data array
     ``set_<name>`` (1 point, 2 edge, 3 surface set; 0 outside) and, for surface sets, a
     cell-data array of the same name; per-element vectors and scalar fields are point and
-    cell data by their names."""
+    cell data by their names. Without ``with_thickness`` the nodal thickness is left out, so
+    that a deck reading the file takes its ``[section] thickness``."""
     import meshio
 
-    point_data = {"director": mesh.director, "thickness": mesh.thickness} | mesh.point_fields
+    point_data = {"director": mesh.director} | ({"thickness": mesh.thickness} if with_thickness else {})
+    point_data |= mesh.point_fields
     cell_data = {name: [values] for name, values in (mesh.cell_vectors | mesh.cell_fields).items()}
     for name, named in mesh.sets.items():
         member = np.zeros(mesh.n_nodes, dtype=np.uint8)

@@ -1,0 +1,711 @@
+"""An Abaqus shell model as a shellsim mesh and deck tables.
+
+Shells (S4, S4R, S8R, S9R5 and their variants) become 9-node quads (:mod:`.quad_upgrade`),
+their node and element sets and element-based surfaces named sets, ``*ORIENTATION`` (with
+per-element ``*DISTRIBUTION``) material axes; the model data and the first step become the
+deck's material, section, boundaries, loads, contact, curves and solver. Every keyword,
+element or option that has no counterpart is listed with its line (``unmapped``).
+
+Signs: Abaqus' positive shell normal follows the corner order by the right-hand rule, and
+is kept as the director where the mesh is consistently oriented; a pressure on a shell's
+positive face (``SPOS``, or ``*DLOAD P``) pushes against that normal. It is brought over
+on the mid-surface, Abaqus' reference surface, as ``face = "mid"`` with the opposite sign.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import MeshError, id_list
+from ..geometry.importing import ImportedMesh
+from ..mesh import NamedSet, averaged_directors, edges_within, element_normals, orient_consistently
+from . import ForeignModel
+from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
+from .quad_upgrade import upgrade
+
+#: Abaqus shell types by their number of nodes.
+SHELLS = {4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"}, 9: {"S9R5"}}
+#: Why other element types cannot come over.
+NOT_SHELLS = {
+    "S3": "triangles: remesh the surface into quads (e.g. write it as STL for geometry.surface)",
+    "T3D2": "line elements (cables, chordae) are not yet shellsim elements",
+    "B31": "beam elements are not shellsim elements",
+    "M3D4": "membranes: shellsim's shells carry bending; model the membrane as a thin shell",
+}
+#: Abaqus' named boundary types: the degrees of freedom they fix.
+BOUNDARY_TYPES = {"encastre": {1, 2, 3, 4, 5, 6}, "pinned": {1, 2, 3}, "xsymm": {1, 5, 6}, "ysymm": {2, 4, 6},
+                  "zsymm": {3, 4, 5}, "xasymm": {2, 3, 4}, "yasymm": {1, 3, 5}, "zasymm": {1, 2, 6}}
+AXES = "xyz"
+
+
+def read_abaqus(path: Path) -> ForeignModel:
+    """The model of the Abaqus input file ``path``; MeshError for one without usable shells."""
+    model = read_model(path)
+    builder = _Builder(model)
+    builder.mesh()
+    builder.material_and_section()
+    builder.curves_of_amplitudes()
+    builder.supports_and_loads()
+    builder.contact()
+    builder.solver()
+    tables = {"meta": {"title": model.heading or path.stem, "description": f"Brought over from {path.name}",
+                       "source": path.name}} | builder.tables
+    return ForeignModel(builder.imported(), tables, model.unmapped, builder.unused_elements)
+
+
+class _Builder:
+    """Maps a flattened :class:`AbaqusModel` piece by piece; the pieces share the mesh and
+    the set names made so far."""
+
+    def __init__(self, model: AbaqusModel):
+        self.model = model
+        self.tables: dict = {}
+        self.unused_elements: list[str] = []
+        self.sets: dict[str, NamedSet] = {}
+        self.set_of: dict[tuple[str, str], str] = {}  # (what, abaqus key) -> deck set name
+        self.curve_of: dict[str, str] = {}  # amplitude key -> curve name
+        self.point_fields: dict[str, np.ndarray] = {}
+        self.cell_vectors: dict[str, np.ndarray] = {}
+        self.thickness: np.ndarray | None = None
+        self.density: float | None = None
+
+    # -- mesh -------------------------------------------------------------------------------
+    def mesh(self) -> None:
+        m = self.model
+        by_kind: dict[str, list] = defaultdict(list)
+        for e in m.elements:
+            by_kind[e.kind].append(e)
+        shells = {size: [e for kind in kinds for e in by_kind.get(kind, [])] for size, kinds in SHELLS.items()}
+        for kind, elements in sorted(by_kind.items()):
+            if not any(kind in kinds for kinds in SHELLS.values()):
+                why = next((text for prefix, text in NOT_SHELLS.items() if kind.startswith(prefix)),
+                           "not a shell element shellsim has")
+                self.unused_elements.append(f"{len(elements)} {kind} element(s) (first at {elements[0].where}): {why}")
+        m.unmapped.extend(self.unused_elements)
+        orders = [size for size, elements in shells.items() if elements]
+        if not orders:
+            raise MeshError(f"model file '{m.path}' has no shell quadrilaterals shellsim reads "
+                            f"({', '.join(sorted(set().union(*SHELLS.values())))}); found "
+                            f"{', '.join(sorted(by_kind)) or 'no elements'}")
+        if len(orders) > 1:
+            raise MeshError(f"model file '{m.path}' mixes shells of {' and '.join(map(str, orders))} nodes; "
+                            "bring them to one order before importing")
+        self.elements = shells[orders[0]]
+        labels = [label for e in self.elements for label in e.nodes]
+        missing = sorted({label for label in labels if label not in m.nodes})
+        if missing:
+            raise MeshError(f"model file '{m.path}': elements use nodes that are not defined: {', '.join(missing[:5])}")
+        for e in self.elements:
+            if len(e.nodes) != orders[0] or len(set(e.nodes)) != orders[0]:
+                raise MeshError(f"model file '{m.path}', element {e.label} ({e.where}): a {e.kind} has "
+                                f"{orders[0]} distinct nodes; got {', '.join(e.nodes)}")
+        used = sorted({m.nodes[label] for label in labels})
+        position = {i: j for j, i in enumerate(used)}
+        self.index_of_label = {label: position[i] for label, i in m.nodes.items() if i in position}
+        x = np.asarray([m.coords[i] for i in used])
+        quads = np.asarray([[self.index_of_label[n] for n in e.nodes] for e in self.elements], dtype=np.int64)
+        if orders[0] == 9:
+            x9, conn = x, quads
+            self.lift = lambda nodes: np.unique(nodes)
+        else:
+            upgraded = upgrade(x, quads)
+            x9, conn, self.lift = upgraded.x, upgraded.conn, upgraded.lift
+        abaqus_normals = element_normals(x9, conn, np.zeros((1, 2)))[:, 0]
+        self.conn = orient_consistently(x9, conn, abaqus_normals)
+        # +1 where the element kept Abaqus' positive normal, -1 where orienting turned it
+        self.side = np.where((self.conn == conn).all(axis=1), 1.0, -1.0)
+        self.x = x9
+        self.director = averaged_directors(x9, self.conn)
+        self.element_of_label = {e.label: i for i, e in enumerate(self.elements)}
+        self._named_sets()
+
+    def _named_sets(self) -> None:
+        m = self.model
+        for key, named in m.elsets.items():
+            elements = self._elements(named.items)
+            if len(elements):
+                self._name(("elset", key), named.name, self._surface_set(elements))
+        for key, named in m.nsets.items():
+            nodes = self._nodes(named.items)
+            if not len(nodes):
+                continue
+            twin = self.set_of.get(("elset", key))
+            if twin is not None and np.array_equal(self.sets[twin].nodes, nodes):
+                self.set_of[("nset", key)] = twin  # CAE writes a region as an nset and an elset alike
+            else:
+                self._name(("nset", key), named.name + ("_nodes" if twin else ""), self._node_set(nodes))
+        for key, named in m.surfaces.items():
+            if named.kind == "node":
+                nodes = self._nodes([label for label, _ in named.items])
+                if len(nodes):
+                    self._name(("surface", key), named.name, self._node_set(nodes))
+                continue
+            elements = self._elements([label for label, _ in named.items])
+            if len(elements):
+                self._name(("surface", key), named.name, self._surface_set(elements))
+
+    def _elements(self, labels) -> np.ndarray:
+        return np.unique([self.element_of_label[label] for label in labels if label in self.element_of_label]
+                         ).astype(np.int64)
+
+    def _nodes(self, labels, lift: bool = True) -> np.ndarray:
+        """The mesh nodes of node ``labels`` and, with ``lift``, the new nodes they span."""
+        given = np.unique([self.index_of_label[label] for label in labels if label in self.index_of_label])
+        return self.lift(given.astype(np.int64)) if len(given) and lift else given.astype(np.int64)
+
+    def _surface_set(self, elements: np.ndarray) -> NamedSet:
+        return NamedSet("surface", np.unique(self.conn[elements]), elements=elements)
+
+    def _node_set(self, nodes: np.ndarray) -> NamedSet:
+        edges = edges_within(self.conn, nodes)
+        if len(nodes) > 1 and len(edges):
+            return NamedSet("edge", nodes, edges=edges)
+        return NamedSet("point", nodes)
+
+    def _name(self, key: tuple[str, str] | None, wanted: str, named: NamedSet) -> str:
+        """Add ``named`` under a deck name made from ``wanted`` (deck names: a letter, then
+        letters, digits, '_' or '-'), unique; remember it under ``key``."""
+        name = re.sub(r"[^A-Za-z0-9_\-]", "_", wanted)
+        name = name if name[:1].isalpha() else "set" + name
+        base, count = name, 1
+        while name.lower() in {n.lower() for n in self.sets}:
+            count += 1
+            name = f"{base}_{count}"
+        self.sets[name] = named
+        if key is not None:
+            self.set_of[key] = name
+        return name
+
+    def node_set_for(self, k: Keyword, tokens: list[str], wanted: str) -> str:
+        """The deck set of the nodes a data line's fields name: the named set itself when
+        only one is named, else a new set ``wanted``."""
+        if len(tokens) == 1 and qualified("", tokens[0]) is None:
+            for what, table in (("nset", self.model.nsets), ("surface", self.model.surfaces)):
+                try:
+                    key = self.model.key_of(table, tokens[0], "", k, "node set")
+                except MeshError:
+                    continue
+                if (what, key) in self.set_of:
+                    return self.set_of[(what, key)]
+        return self.new_node_set(k, [label for token in dict.fromkeys(tokens)
+                                     for label in self.model.node_labels(token, "", k)], wanted)
+
+    def new_node_set(self, k: Keyword, labels: list[str], wanted: str, lift: bool = True) -> str:
+        """A new deck set ``wanted`` of the nodes with the (qualified) ``labels`` (and, with
+        ``lift``, the new nodes between them)."""
+        nodes = self._nodes(labels, lift)
+        if not len(nodes):
+            raise MeshError(f"{k.label()}: names no node of a shell element")
+        return self._name(None, wanted, self._node_set(nodes))
+
+    def imported(self) -> ImportedMesh:
+        return ImportedMesh(self.x, self.conn, self.sets, self.director, self.thickness, self.cell_vectors,
+                            self.point_fields, {})
+
+    # -- material and section ---------------------------------------------------------------
+    def material_and_section(self) -> None:
+        m = self.model
+        covered = np.zeros(len(self.elements), dtype=bool)
+        thickness = np.full(len(self.elements), np.nan)
+        chosen = None
+        for k, elset, prefix in m.sections:
+            elements = self._elements(m.elsets[elset].items)
+            if k.name != "shell section":
+                m.unmapped.append(f"{k.label()}: a {k.name} is not a shellsim section; its elements are left without one")
+                continue
+            if not k.rows or not k.rows[0] or not _is_number(k.rows[0][0]):
+                m.unmapped.append(f"{k.label()}: the thickness is not a number (a distribution or nodal thickness); "
+                                  "give [section] thickness")
+                continue
+            covered[elements] = True
+            thickness[elements] = float(k.rows[0][0])
+            material = (k.param("material") or "").lower()
+            if chosen is None:
+                chosen = (material, k, prefix)
+            elif material != chosen[0]:
+                m.unmapped.append(f"{k.label()}: material '{k.param('material')}' on elements "
+                                  f"{id_list(elements + 1)}: a deck has one material; '{chosen[1].param('material')}' "
+                                  "is used everywhere")
+            for option in ("offset", "nodal thickness", "shell thickness"):
+                if option in k.params:
+                    m.unmapped.append(f"{k.label()}: {option.upper()} is not read (shellsim's reference surface is "
+                                      "the mid-surface; thickness is [section] thickness)")
+        if not covered.all():
+            raise MeshError(f"model file '{m.path}': shell elements without a shell section: "
+                            f"{id_list([e.label for e, c in zip(self.elements, covered) if not c])}")
+        if chosen is None:
+            raise MeshError(f"model file '{m.path}' has no *SHELL SECTION")
+        values, counts = np.unique(thickness, return_counts=True)
+        section: dict = {"thickness": float(values[counts.argmax()])}  # the mesh file's nodal values rule where they differ
+        if len(values) > 1:  # nodal thickness, each node the mean of its elements' thicknesses
+            total = np.zeros(len(self.x))
+            count = np.zeros(len(self.x))
+            np.add.at(total, self.conn, thickness[:, None])
+            np.add.at(count, self.conn, 1.0)
+            self.thickness = total / count
+        material = self._material(*chosen)
+        if material is not None:
+            if material["model"] != "linear_elastic" or "nlgeom" in self._step_params():
+                section["technique"] = 1
+            self.tables["material"] = material
+        self.tables["section"] = section
+
+    def _step_params(self) -> dict[str, str]:
+        step = self.model.steps[0][0].params if self.model.steps else {}
+        return {k: v for k, v in step.items() if not (k == "nlgeom" and v.upper() in ("NO", "OFF"))}
+
+    def _material(self, key: str, section: Keyword, prefix: str) -> dict | None:
+        m = self.model
+        if key not in m.materials:
+            raise MeshError(f"{section.label()}: unknown material '{section.param('material')}'")
+        k, options = m.materials[key]
+        name = k.param("name")
+        by_name = {o.name: o for o in options}
+        density = by_name.pop("density", None)
+        self.density = float(density.rows[0][0]) if density is not None else None
+        user = by_name.pop("user material", None)
+        by_name.pop("depvar", None)
+        table: dict | None = None
+        if user is not None:
+            constants = ", ".join(v for row in user.rows for v in row)
+            m.unmapped.append(f"{user.label()}: user material '{name}' (constants {constants}): name the law in "
+                              "[material] instead, e.g. model = 'lee_sacks' (c0, c1, c2, c3, delta) for leaflets or "
+                              "'hgo' for arteries (docs/decks.md)")
+        elif "anisotropic hyperelastic" in by_name:
+            table = self._holzapfel(by_name.pop("anisotropic hyperelastic"), section, prefix)
+        elif "hyperelastic" in by_name:
+            table = self._hyperelastic(by_name.pop("hyperelastic"))
+        elif "elastic" in by_name:
+            e = by_name.pop("elastic")
+            if (e.param("type") or "isotropic").lower() != "isotropic":
+                m.unmapped.append(f"{e.label()}: only isotropic elasticity maps (TYPE={e.param('type')})")
+            else:
+                table = {"model": "linear_elastic", "E": float(e.rows[0][0]), "nu": float(e.rows[0][1])}
+        else:
+            m.unmapped.append(f"{k.label()}: material '{name}' has no law shellsim maps; name one in [material]")
+        for option in by_name.values():
+            m.unmapped.append(f"{option.label()}: *{option.name.upper()} of material '{name}' is not read")
+        if table is None:
+            return None
+        if self.density is None:
+            m.unmapped.append(f"{k.label()}: material '{name}' has no *DENSITY; the deck's density 1.0 is a "
+                              "placeholder (only an explicit run uses it)")
+        return table | {"density": self.density if self.density is not None else 1.0}
+
+    def _hyperelastic(self, k: Keyword) -> dict | None:
+        forms = [f for f in ("neo hooke", "mooney-rivlin", "polynomial", "reduced polynomial", "ogden", "yeoh",
+                             "arruda-boyce", "van der waals", "marlow") if f in k.params]
+        form = forms[0] if forms else "polynomial"
+        order = int(k.param("n") or 1)
+        row = [float(v) for v in k.rows[0]] if k.rows else []
+        if form in ("neo hooke", "reduced polynomial") and order == 1:
+            table, d1 = {"model": "neo_hookean", "C1": row[0]}, row[1:2]
+        elif form in ("mooney-rivlin", "polynomial") and order == 1:
+            table, d1 = {"model": "mooney_rivlin", "C1": row[0], "C2": row[1]}, row[2:3]
+        else:
+            self.model.unmapped.append(f"{k.label()}: the {form.upper()} form (N={order}) has no shellsim law; name "
+                                       "one in [material]")
+            return None
+        if d1 and d1[0] != 0.0:
+            self.model.unmapped.append(f"{k.label()}: D1 = {d1[0]:g} (compressibility) is dropped: shellsim's "
+                                       "hyperelastic laws are incompressible")
+        return table
+
+    def _holzapfel(self, k: Keyword, section: Keyword, prefix: str) -> dict | None:
+        if "holzapfel" not in k.params:
+            self.model.unmapped.append(f"{k.label()}: only the HOLZAPFEL form of *ANISOTROPIC HYPERELASTIC maps")
+            return None
+        c10, d, k1, k2, kappa = ([float(v) for v in k.rows[0]] + [0.0] * 5)[:5]
+        axes, families = self._axes(section, prefix)
+        if families is None or len(families) != 2 or not np.isclose(families[0][1], -families[1][1]) \
+                or not np.isclose(families[0][0], families[1][0]):
+            self.model.unmapped.append(f"{k.label()}: shellsim's HGO has two fibre families at +-beta from material "
+                                       "axis 1; give them as the orientation's two LOCAL DIRECTIONS (cos b, +-sin b, 0)")
+            return None
+        if d != 0.0:
+            self.model.unmapped.append(f"{k.label()}: D = {d:g} (compressibility) is dropped: shellsim's HGO is "
+                                       "incompressible")
+        beta = float(np.degrees(np.arctan2(families[0][1], families[0][0])))
+        return {"model": "hgo", "mu": 2.0 * c10, "k1": k1, "k2": k2, "kappa": kappa, "beta_deg": abs(beta),
+                "axes": axes}
+
+    def _axes(self, section: Keyword, prefix: str) -> tuple[dict, list | None]:
+        """The material axes of a section's orientation and its local directions (rows)."""
+        name = section.param("orientation")
+        if name is None:  # Abaqus' default on a shell: global x projected on it
+            return {"kind": "fixed", "direction": [1.0, 0.0, 0.0]}, None
+        k, own = self.model.orientations[self.model.key_of(self.model.orientations, name, prefix, section, "orientation")]
+        if (k.param("system") or "rectangular").lower() != "rectangular":
+            self.model.unmapped.append(f"{k.label()}: SYSTEM={k.param('system')} is not read; axis 1 taken along x")
+            return {"kind": "fixed", "direction": [1.0, 0.0, 0.0]}, None
+        angle = 0.0
+        if len(k.rows) > 1 and k.rows[1]:
+            axis, angle = int(float(k.rows[1][0])), float(k.rows[1][1]) if len(k.rows[1]) > 1 else 0.0
+            if axis != 3 and angle != 0.0:
+                self.model.unmapped.append(f"{k.label()}: a rotation about local axis {axis} does not keep a shell's "
+                                           "axes in its surface; not read")
+                angle = 0.0
+        n = int(k.param("local directions") or 0)
+        families = [[float(v) for v in row[:3]] for row in k.rows[2:2 + n]] or None
+        first = k.rows[0]
+        if len(first) == 1 and not _is_number(first[0]):
+            field = self._distribution(first[0], own, k)
+            axes = {"kind": "mesh", "field": field}
+        else:
+            axes = {"kind": "fixed", "direction": [float(v) for v in first[:3]]}
+        return axes | ({"angle_deg": angle} if angle else {}), families
+
+    def _distribution(self, name: str, prefix: str, where: Keyword) -> str:
+        """Per-element directions from a ``*DISTRIBUTION`` (first column: the element, the
+        default row blank) as the cell vectors named after it."""
+        k, own = self.model.distributions[self.model.key_of(self.model.distributions, name, prefix, where,
+                                                               "distribution")]
+        default = None
+        vectors = np.full((len(self.elements), 3), np.nan)
+        for row in k.rows:
+            values = np.asarray([float(v) for v in row[1:4]])
+            if row[0] == "":
+                default = values
+                continue
+            for label in self.model.element_labels(row[0], own, k):
+                if label in self.element_of_label:
+                    vectors[self.element_of_label[label]] = values
+        if default is not None:
+            vectors[np.isnan(vectors).any(axis=1)] = default
+        if np.isnan(vectors).any():
+            missing = [e.label for e, v in zip(self.elements, vectors) if np.isnan(v).any()]
+            raise MeshError(f"{k.label()}: no direction for elements {id_list(missing)} (and no default row)")
+        field = re.sub(r"[^A-Za-z0-9_\-]", "_", k.param("name") or "orientation")
+        field = field if field[:1].isalpha() else "axis" + field
+        self.cell_vectors[field] = vectors
+        return field
+
+    # -- curves -----------------------------------------------------------------------------
+    def curves_of_amplitudes(self) -> None:
+        curves = {}
+        for key, k in self.model.amplitudes.items():
+            definition = (k.param("definition") or "tabular").lower()
+            values = [float(v) for row in k.rows for v in row if v != ""]
+            if definition == "equally spaced":
+                step, begin = float(k.param("fixed interval")), float(k.param("begin") or 0.0)
+                t, a = [begin + i * step for i in range(len(values))], values
+            elif definition in ("tabular", "smooth step"):
+                t, a = values[0::2], values[1::2]
+            else:
+                self.model.unmapped.append(f"{k.label()}: DEFINITION={k.param('definition')} has no shellsim curve; "
+                                           "tabulate it")
+                continue
+            if (k.param("value") or "relative").lower() == "absolute":
+                self.model.unmapped.append(f"{k.label()}: VALUE=ABSOLUTE: in shellsim a curve scales the load's value")
+            name = re.sub(r"[^A-Za-z0-9_\-]", "_", k.param("name") or "amplitude")
+            name = name if name[:1].isalpha() else "curve" + name
+            curve = {"t": t, "value": a}
+            if definition == "smooth step":
+                curve["interpolate"] = "smooth"
+                self.model.unmapped.append(f"{k.label()}: SMOOTH STEP is brought over as shellsim's smooth curve "
+                                           "(a cubic with zero slope at every point; Abaqus' is a quintic: the same at "
+                                           "the points, close between)")
+            curves[name] = curve
+            self.curve_of[key] = name
+        self.used_curves: set[str] = set()
+        self.all_curves = curves
+
+    def _curve(self, k: Keyword) -> dict:
+        name = k.param("amplitude")
+        if name is None:
+            return {}
+        key = name.lower()
+        if key not in self.curve_of:
+            raise MeshError(f"{k.label()}: unknown amplitude '{name}'")
+        self.used_curves.add(self.curve_of[key])
+        return {"curve": self.curve_of[key]}
+
+    # -- supports and loads -----------------------------------------------------------------
+    def supports_and_loads(self) -> None:
+        step = self.model.steps[0][1] if self.model.steps else []
+        keywords = self.model.model_data + step
+        boundary, loads = [], []
+        held: dict[str, tuple[Keyword, list[str], set[int]]] = {}  # token -> (first keyword, tokens, dofs)
+        moved: dict[tuple[int, str], dict] = {}
+        for k in keywords:
+            if k.name == "boundary":
+                self._boundary(k, held, moved)
+            elif k.name == "cload":
+                loads += self._cload(k)
+            elif k.name in ("dload", "dsload"):
+                loads += self._distributed(k)
+        for k, tokens, dofs in held.values():
+            entry = self._support(k, tokens, dofs)
+            if entry is not None:
+                boundary.append(entry)
+        for (dof, _), entry in moved.items():
+            boundary.append(self._prescribed(dof, entry))
+        if boundary:
+            self.tables["boundary"] = boundary
+        if loads:
+            self.tables["load"] = loads
+        curves = {name: c for name, c in self.all_curves.items() if name in self.used_curves}
+        if curves:
+            self.tables["curves"] = curves
+
+    def _boundary(self, k: Keyword, held: dict, moved: dict) -> None:
+        kind = (k.param("type") or "displacement").lower()
+        if kind != "displacement":
+            self.model.unmapped.append(f"{k.label()}: TYPE={k.param('type')} is not read (shellsim prescribes "
+                                       "displacements)")
+            return
+        if (k.param("op") or "").lower() == "new":
+            self.model.unmapped.append(f"{k.label()}: OP=NEW: shellsim keeps the model's boundaries as well")
+        for row, line in zip(k.rows, k.row_lines):
+            token = row[0]
+            if len(row) > 1 and row[1].lower() in BOUNDARY_TYPES:
+                dofs, value = BOUNDARY_TYPES[row[1].lower()], 0.0
+            else:
+                try:
+                    first = int(row[1])
+                    last = int(row[2]) if len(row) > 2 and row[2] else first
+                    value = float(row[3]) if len(row) > 3 and row[3] else 0.0
+                except (ValueError, IndexError):
+                    raise MeshError(f"{k.at(line)}: expected 'node or set, first dof[, last dof[, value]]' "
+                                    f"or a boundary type ({', '.join(t.upper() for t in BOUNDARY_TYPES)}); got "
+                                    f"'{', '.join(row)}'") from None
+                dofs = set(range(first, last + 1))
+            if value == 0.0:
+                entry = held.setdefault(token.lower() if qualified("", token) is None else f"node {token.lower()}",
+                                        (k, [token], set()))
+                entry[2].update(dofs)
+                continue
+            for dof in dofs:
+                if dof > 3:
+                    self.model.unmapped.append(f"{k.at(line)}: a rotation prescribed to {value:g} is not "
+                                               "read (shellsim prescribes translations)")
+                    continue
+                entry = moved.setdefault((dof, k.param("amplitude") or ""), {"keyword": k, "values": {}, "tokens": []})
+                entry["tokens"].append(token)
+                for label in self.model.node_labels(token, "", k):
+                    entry["values"][label] = value
+
+    def _support(self, k: Keyword, tokens: list[str], dofs: set[int]) -> dict | None:
+        translations = sorted(d for d in dofs if d <= 3)
+        rotations = {d for d in dofs if d > 3}
+        name = self.node_set_for(k, tokens, f"support_{tokens[0]}")
+        if len(translations) == 3 and len(rotations) == 3:
+            return {"type": "clamped", "set": name}
+        for axis in range(3):  # XSYMM and its kin: one translation and the two rotations that tilt the plane
+            if translations == [axis + 1] and rotations == {4, 5, 6} - {axis + 4}:
+                return {"type": "symmetry", "set": name, "normal": [float(axis == i) for i in range(3)]}
+        entry: dict = {"type": "fixed", "set": name, "translations": [AXES[d - 1] for d in translations]}
+        if len(rotations) == 3:
+            entry["director"] = "fixed"
+        elif len(rotations) == 2:  # free only about one axis: the director turns in the plane normal to it
+            free = ({4, 5, 6} - rotations).pop() - 4
+            entry["director_plane_normal"] = [float(free == i) for i in range(3)]
+        elif len(rotations) == 1:
+            self.model.unmapped.append(f"{k.label()}: on '{tokens[0]}' the rotation about {AXES[min(rotations) - 4]} "
+                                       "alone is held; a director has no such single rotation: left free (state the "
+                                       "support with director_plane_normal in the deck)")
+        if not translations and "director" not in entry and "director_plane_normal" not in entry:
+            return None
+        return entry
+
+    def _prescribed(self, dof: int, entry: dict) -> dict:
+        k, values = entry["keyword"], entry["values"]
+        distinct = sorted(set(values.values()))
+        name = self.node_set_for(k, entry["tokens"], f"moved_{AXES[dof - 1]}")
+        table = {"type": "prescribed", "set": name, "translation": AXES[dof - 1]} | self._curve(k)
+        if len(distinct) == 1:
+            return table | {"value": distinct[0]}
+        field = np.zeros(len(self.x))
+        given = {self.index_of_label[label]: v for label, v in values.items() if label in self.index_of_label}
+        field[list(given)] = list(given.values())
+        # a new mid-edge node moves as the mean of its corners (its corners are both given)
+        nodes = self.sets[name].nodes
+        known = np.zeros(len(self.x), dtype=bool)
+        known[list(given)] = True
+        for node in nodes[~known[nodes]]:
+            corners = self._corners_of(node)
+            field[node] = field[corners].mean()
+        self.point_fields[name] = field
+        return table | {"value": 1.0, "field": name}
+
+    def _corners_of(self, node: int) -> np.ndarray:
+        """The given (corner) nodes a new node lies between: an edge's two, a centre's four."""
+        e, position = np.argwhere(self.conn == node)[0]
+        if position == 8:
+            return self.conn[e, :4]
+        return self.conn[e, [position - 4, (position - 3) % 4]]
+
+    def _cload(self, k: Keyword) -> list[dict]:
+        vectors: dict[str, np.ndarray] = defaultdict(lambda: np.zeros(6))
+        for row, line in zip(k.rows, k.row_lines):
+            try:
+                dof, magnitude = int(row[1]), float(row[2])
+            except (ValueError, IndexError):
+                raise MeshError(f"{k.at(line)}: expected 'node or set, dof, magnitude'; got "
+                                f"'{', '.join(row)}'") from None
+            for label in self.model.node_labels(row[0], "", k):
+                vectors[label][dof - 1] += magnitude
+        groups: dict[tuple, list[str]] = defaultdict(list)
+        for label, vector in vectors.items():
+            groups[tuple(vector)].append(label)
+        loads = []
+        tokens = [row[0] for row in k.rows]
+        # a concentrated load acts on the nodes the file names, not on the new ones between them
+        wanted = f"{tokens[0]}_loaded" if len(groups) == 1 and len(set(tokens)) == 1 else f"cload_{k.where.split(':')[-1]}"
+        for vector, labels in groups.items():
+            name = self.new_node_set(k, labels, wanted, lift=False)
+            for kind, part in (("point_force", vector[:3]), ("point_moment", vector[3:])):
+                if any(part):
+                    loads.append({"type": kind, "set": name, "value": list(part)} | self._curve(k))
+        return loads
+
+    def _distributed(self, k: Keyword) -> list[dict]:
+        loads = []
+        for row, line in zip(k.rows, k.row_lines):
+            kind = row[1].upper() if len(row) > 1 else ""
+            try:
+                values = [float(v) for v in row[2:]]
+            except ValueError:
+                raise MeshError(f"{k.at(line)}: the magnitude is not a number: '{', '.join(row)}'") from None
+            if kind == "P":
+                loads += self._pressure(k, row[0], values[0])
+            elif kind == "GRAV" and k.name == "dload":
+                if self.density is None:
+                    self.model.unmapped.append(f"{k.at(line)}: gravity needs the material's *DENSITY")
+                    continue
+                direction = np.asarray(values[1:4])
+                loads.append({"type": "body_force", "set": self._elements_set(k, row[0]),
+                              "value": list(self.density * values[0] * direction)} | self._curve(k))
+            elif kind in ("BX", "BY", "BZ") and k.name == "dload":
+                value = [values[0] * (kind[1] == axis.upper()) for axis in AXES]
+                loads.append({"type": "body_force", "set": self._elements_set(k, row[0]), "value": value}
+                             | self._curve(k))
+            else:
+                self.model.unmapped.append(f"{k.at(line)}: load type {kind} is not read")
+        return loads
+
+    def _elements_set(self, k: Keyword, token: str) -> str:
+        if qualified("", token) is None:
+            key = self.model.key_of(self.model.elsets, token, "", k, "element set")
+            if ("elset", key) in self.set_of:
+                return self.set_of[("elset", key)]
+        elements = self._elements(self.model.element_labels(token, "", k))
+        return self._name(None, f"load_{k.where.split(':')[-1]}", self._surface_set(elements))
+
+    def _pressure(self, k: Keyword, token: str, magnitude: float) -> list[dict]:
+        """Pressure loads on the mid-surface: the elements whose director is Abaqus' positive
+        normal and the others, each with the sign that pushes where Abaqus pushes."""
+        if k.name == "dsload":
+            surface = self.model.surface(token, k)
+            if surface.kind == "node":
+                self.model.unmapped.append(f"{k.label()}: pressure on the node-based surface '{token}' is not read")
+                return []
+            faces = [(self.element_of_label[label], side) for label, side in surface.items
+                     if label in self.element_of_label]
+            if any(side not in ("SPOS", "SNEG") for _, side in faces):
+                self.model.unmapped.append(f"{k.label()}: surface '{token}' has faces that are neither SPOS nor SNEG; "
+                                           "read as SPOS")
+            sign = np.asarray([-1.0 if side != "SNEG" else 1.0 for _, side in faces])
+            elements = np.asarray([e for e, _ in faces], dtype=np.int64)
+            whole = ("surface", self.model.key_of(self.model.surfaces, token, "", k, "surface"))
+        else:
+            elements = self._elements(self.model.element_labels(token, "", k))
+            sign = -np.ones(len(elements))
+            whole = ("elset", self.model.key_of(self.model.elsets, token, "", k, "element set")) \
+                if qualified("", token) is None else None
+        sign = sign * self.side[elements]
+        loads = []
+        for s in (-1.0, 1.0):
+            chosen = np.unique(elements[sign == s])
+            if not len(chosen):
+                continue
+            if whole in self.set_of and np.array_equal(self.sets[self.set_of[whole]].elements, chosen):
+                name = self.set_of[whole]
+            else:
+                name = self._name(None, f"pressure_{k.where.split(':')[-1]}", self._surface_set(chosen))
+            loads.append({"type": "pressure", "set": name, "value": s * magnitude, "face": "mid"} | self._curve(k))
+        return loads
+
+    # -- contact and solver -----------------------------------------------------------------
+    def contact(self) -> None:
+        m = self.model
+        keywords = m.model_data + (m.steps[0][1] if m.steps else [])
+        contacts = []
+        general = any(k.name == "contact" for k in keywords)
+        friction_of = {key: self._friction(options) for key, options in m.interactions.items()}
+        assigned = [k for k in keywords if k.name == "contact property assignment"]
+        general_friction = next((friction_of.get(row[2].lower(), 0.0) for k in assigned for row in k.rows
+                                 if len(row) > 2), 0.0)
+        for k in keywords:
+            if k.name == "contact pair":
+                friction = friction_of.get((k.param("interaction") or "").lower(), 0.0)
+                pairs = k.rows
+            elif k.name == "contact inclusions" and general:
+                friction = general_friction
+                pairs = [["all", "all"]] if "all exterior" in k.params else k.rows
+            else:
+                continue
+            for row in pairs:
+                names = [n if n.lower() == "all" else self.set_of.get(("surface", m.key_of(m.surfaces, n, "", k, "surface")))
+                         for n in (row + row[:1])[:2]]
+                if None in names:
+                    m.unmapped.append(f"{k.label()}: a contact of node-based surfaces is not read")
+                    continue
+                entry = {"type": "shells", "name": f"contact_{len(contacts) + 1}", "set": names[0]}
+                if names[1] != names[0]:
+                    entry["against"] = names[1]
+                contacts.append(entry | ({"friction": friction} if friction else {}))
+        if contacts:
+            self.tables["contact"] = contacts
+
+    @staticmethod
+    def _friction(options: list[Keyword]) -> float:
+        for k in options:
+            if k.name == "friction" and k.rows and k.rows[0] and _is_number(k.rows[0][0]):
+                return float(k.rows[0][0])
+        return 0.0
+
+    def solver(self) -> None:
+        m = self.model
+        if not m.steps:
+            m.unmapped.append(f"model file '{m.path.name}' has no *STEP: a static solve to pseudo-time 1 is assumed")
+            self.tables["solver"] = {"method": "static", "end_time": 1.0}
+            return
+        for k, _ in m.steps[1:]:
+            m.unmapped.append(f"{k.label()}: only the first step is brought over")
+        step, items = m.steps[0]
+        procedures = [k for k in items if k.name in ("static", "dynamic")]
+        known = {"static", "dynamic", "boundary", "cload", "dload", "dsload", "contact pair", "contact",
+                 "contact inclusions", "contact property assignment"}
+        for k in items:
+            if k.name not in known and k.name not in OUTPUT_REQUESTS:
+                m.unmapped.append(f"{k.label()}: not read by shellsim")
+        if not procedures:
+            m.unmapped.append(f"{step.label()}: a step without *STATIC or *DYNAMIC: a static solve to pseudo-time 1 "
+                              "is assumed")
+            self.tables["solver"] = {"method": "static", "end_time": 1.0}
+            return
+        k = procedures[0]
+        row = [float(v) if _is_number(v) else None for v in (k.rows[0] if k.rows else [])] + [None] * 4
+        if k.name == "static":
+            period = row[1] or 1.0
+            solver: dict = {"method": "static", "end_time": period}
+            if row[0]:
+                solver["static"] = {"increments": max(1, round(period / row[0]))}
+        else:
+            if "explicit" not in k.params:
+                m.unmapped.append(f"{k.label()}: implicit dynamics: shellsim integrates the step explicitly")
+            solver = {"method": "explicit", "end_time": row[1] or 1.0}
+        self.tables["solver"] = solver
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True

@@ -1,0 +1,113 @@
+"""``shellsim import``: a model file brought over as an editable deck and its mesh, the
+deck's header listing what was not brought over, the deck checked as ``check`` would."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DeckError, OutputError, ShellsimError
+from ..mesh import Mesh
+from ..output.folder import output_folder, write_atomically
+from . import read_foreign
+
+DECK_NAME = "deck.toml"
+#: The deck's tables in the order a reader expects them.
+ORDER = ("meta", "geometry", "material", "section", "boundary", "load", "contact", "curves", "solver")
+
+
+@dataclass(frozen=True)
+class Imported:
+    """What ``shellsim import`` wrote: the deck, the mesh, the sets, the lines of what was
+    not brought over and the deck's problems (empty when it runs as written)."""
+
+    deck: Path
+    mesh: Path
+    elements: int
+    sets: dict[str, str]
+    unmapped: list[str]
+    problems: list[str]
+
+
+def import_model(source: Path, folder: Path) -> Imported:
+    """Bring the model ``source`` over into ``folder`` as DECK_NAME and ``<stem>.vtu``.
+
+    Refuses (OutputError) to replace a deck already in ``folder``; MeshError for a model
+    that cannot be read. The deck is validated and its sets checked against the mesh; its
+    problems are returned, not raised: the deck is there to be edited.
+    """
+    from ..output.mesh_files import write_mesh_vtu
+
+    deck_path, mesh_path = folder / DECK_NAME, folder / f"{source.stem}.vtu"
+    if deck_path.exists():
+        raise OutputError(f"'{deck_path}' exists: import into another folder (--out) or move it away first")
+    model = read_foreign(source)
+    output_folder(folder)
+    m = model.mesh
+    thickness = m.thickness if m.thickness is not None else np.full(len(m.x), model.tables["section"]["thickness"])
+    mesh = Mesh(x=m.x, conn=m.conn, director=m.director, thickness=thickness, sets=m.sets,
+                cell_vectors=m.cell_vectors, point_fields=m.point_fields, cell_fields=m.cell_fields)
+    write_mesh_vtu(mesh, mesh_path, with_thickness=m.thickness is not None)
+    tables = model.tables | {"geometry": {"builder": "file", "path": mesh_path.name}}
+    text = _header(source, model.unmapped) + deck_text({key: tables[key] for key in ORDER if key in tables})
+    write_atomically(deck_path, text)
+    return Imported(deck_path, mesh_path, len(m.conn), {name: s.kind for name, s in m.sets.items()}, model.unmapped,
+                    _problems(deck_path))
+
+
+def deck_text(tables: dict) -> str:
+    """TOML of deck ``tables`` as a person writes it: one ``[table]`` or ``[[table]]`` per
+    entry, sub-tables and vectors inline (``axes = { kind = "fixed", ... }``)."""
+    blocks = []
+    for key, value in tables.items():
+        if isinstance(value, list):
+            blocks += [f"[[{key}]]\n" + _keys(item) for item in value]
+        elif key == "curves":
+            blocks += [f"[curves.{name}]\n" + _keys(curve) for name, curve in value.items()]
+        else:
+            blocks.append(f"[{key}]\n" + _keys(value))
+    return "\n".join(blocks)
+
+
+def _keys(table: dict) -> str:
+    return "".join(f"{key} = {_inline(value)}\n" for key, value in table.items())
+
+
+def _inline(value) -> str:
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{key} = {_inline(v)}" for key, v in value.items()) + " }"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_inline(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return json.dumps(str(value))  # a JSON string is a TOML basic string
+
+
+def _header(source: Path, unmapped: list[str]) -> str:
+    lines = [f"# Brought over from {source.name} by `shellsim import`."]
+    if unmapped:
+        lines += ["# Not brought over (state these in the deck where the scene needs them):"]
+        lines += [f"#   - {line}" for line in unmapped]
+    return "\n".join(lines) + "\n\n"
+
+
+def _problems(deck_path: Path) -> list[str]:
+    """What ``shellsim check`` would refuse in the written deck (its sets read from the mesh)."""
+    from ..deck import load_deck
+    from ..geometry import build_mesh
+
+    try:
+        deck = load_deck(deck_path)
+        build_mesh(deck, deck_path.parent)
+    except DeckError as error:
+        return error.problems
+    except ShellsimError as error:
+        return [str(error)]
+    return []

@@ -1,0 +1,258 @@
+"""Models brought over from Abaqus input files: the mesh made 9-node, the sets, supports,
+loads, materials and steps mapped, what does not map listed with its line; checked on
+closed forms (a cantilever's tip deflection, a cylinder's radius, pressure resultants)."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.deck import load_deck, parse_deck
+from shellsim.errors import MeshError
+from shellsim.foreign import read_foreign
+from shellsim.foreign.quad_upgrade import upgrade
+from shellsim.foreign.writing import deck_text, import_model
+from shellsim.geometry import build_mesh
+from shellsim.geometry.importing import read_mesh
+from shellsim.model import build_model
+
+from .conftest import initial_external_forces, run_deck
+
+
+def strip_inp(tip_force: float = -1e-3, extra_model: str = "", extra_step: str = "", reversed_elements: tuple = (),
+              nx: int = 10, ny: int = 2) -> str:
+    """An Abaqus input of a cantilever strip as CAE writes one: a part of S4R elements
+    placed by an instance shifted 5 along x, an assembly-level node set clamped, a force
+    on each tip node ramped by an amplitude in a static step. L = 10, b = 1, t = 0.1,
+    E = 2e5, nu = 0; ``extra_model`` and ``extra_step`` lines go before the first
+    *BOUNDARY and at the step's end, elements ``reversed_elements`` are numbered clockwise."""
+    length, width = 10.0, 1.0
+    nodes = [(1 + i + j * (nx + 1), i * length / nx, j * width / ny) for j in range(ny + 1) for i in range(nx + 1)]
+    lines = ["*Heading", " Cantilever strip, S4R, tip load", "** a comment", "*Part, name=Strip", "*Node"]
+    lines += [f"{n}, {x!r}, {y!r}, 0." for n, x, y in nodes]
+    lines += ["*Element, type=S4R"]
+    for j in range(ny):
+        for i in range(nx):
+            n1 = 1 + i + j * (nx + 1)
+            corners = [n1, n1 + 1, n1 + nx + 2, n1 + nx + 1]
+            label = 1 + i + j * nx
+            lines.append(", ".join(map(str, [label] + (corners[::-1] if label in reversed_elements else corners))))
+    lines += ["*Nset, nset=Root", ", ".join(str(n) for n, x, _ in nodes if x == 0.0) + ",",
+              "*Nset, nset=Tip", ", ".join(str(n) for n, x, _ in nodes if x == length),
+              "*Elset, elset=Whole, generate", f"1, {nx * ny}, 1",
+              "*Shell Section, elset=Whole, material=Steel", "0.1, 5", "*End Part",
+              "*Assembly, name=Assembly", "*Instance, name=Strip-1, part=Strip", "5., 0., 0.", "*End Instance",
+              "*Nset, nset=Fixed, instance=Strip-1", "Root,",
+              "*Elset, elset=_Top, internal, instance=Strip-1, generate", f"1, {nx * ny}, 1",
+              "*Surface, type=ELEMENT, name=TopSurf", "_Top, SPOS", "*End Assembly",
+              "*Amplitude, name=Ramp", "0., 0., 1., 1.",
+              "*Material, name=Steel", "*Density", "7.8e-9", "*Elastic", "200000., 0.0",
+              extra_model, "*Boundary", "Fixed, ENCASTRE",
+              "*Step, name=Load, nlgeom=YES", "*Static", "0.25, 1., 1e-05, 1.",
+              "*Cload, amplitude=Ramp", f"Strip-1.Tip, 3, {tip_force}", extra_step,
+              "*Output, field, variable=PRESELECT", "*End Step"]
+    return "\n".join(line for line in lines if line) + "\n"
+
+
+@pytest.fixture
+def strip(tmp_path):
+    def write(**options):
+        path = tmp_path / "strip.inp"
+        path.write_text(strip_inp(**options))
+        return path
+    return write
+
+
+def test_an_imported_cantilever_bends_as_beam_theory_says(strip, tmp_path):
+    """The strip (L = 10, b = 1, t = 0.1, E = 2e5, nu = 0) brought over and solved
+    statically: its tip deflection under the three tip forces is P L^3 / (3 E I) (shear
+    adds PL/(kGA), 6e-5 of it) within 0.5%, small enough (0.6% of L) to stay linear."""
+    done = import_model(strip(), tmp_path / "imported")
+    assert done.problems == []
+    text = done.deck.read_text() + '''
+[[output.probe]]
+name = "tip"
+quantity = "displacement"
+set = "Strip-1_Tip"
+component = "z"
+'''
+    done.deck.write_text(text)
+    run = run_deck(load_deck(done.deck), done.deck.parent)
+    assert run.status == "completed"
+    total, inertia = 3 * 1e-3, 1.0 * 0.1**3 / 12
+    exact = -total * 10.0**3 / (3 * 2e5 * inertia)
+    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+
+
+def test_the_strip_s_deck_says_what_the_file_says(strip, tmp_path):
+    """Sets qualified by the instance and renamed to deck names, the clamp, the tip force on
+    the three nodes the file names (not the new ones between them), the amplitude as a
+    curve, the static step's span and first increment, NLGEOM as the total formulation,
+    the instance's shift applied, the output request listed with its line."""
+    done = import_model(strip(), tmp_path / "imported")
+    deck = load_deck(done.deck)
+    mesh = build_mesh(deck, done.deck.parent)
+    assert mesh.n_elements == 20 and mesh.x[:, 0].min() == 5.0 and mesh.x[:, 0].max() == 15.0
+    assert deck.boundary[0].type == "clamped" and deck.boundary[0].set == "Fixed"
+    assert len(mesh.sets["Fixed"].nodes) == 5 and mesh.sets["Fixed"].kind == "edge"  # 3 corners and 2 new mid-edge nodes
+    force, = deck.load
+    assert force.type == "point_force" and tuple(force.value) == (0.0, 0.0, -1e-3) and force.curve == "Ramp"
+    assert len(mesh.sets[force.set].nodes) == 3
+    assert deck.curves["Ramp"].t == [0.0, 1.0] and deck.solver.method == "static"
+    assert deck.solver.static.increments == 4 and deck.section.technique == 1
+    assert any(re.search(r"\*OUTPUT.*strip\.inp:\d+", line) for line in done.unmapped)
+    assert done.deck.read_text().startswith("# Brought over from strip.inp")
+
+
+@pytest.mark.parametrize("face, step, sign", [
+    ("SPOS", "*Dsload\nTopSurf, P, 2.0", -1.0),
+    ("SNEG", "*Dsload\nTopSurf, P, 2.0", 1.0),
+    ("SPOS", "*Dload\nStrip-1.Whole, P, 2.0", -1.0),
+])
+def test_pressure_pushes_where_abaqus_pushes_whichever_way_elements_were_numbered(tmp_path, face, step, sign):
+    """A pressure p = 2 on the SPOS face pushes against each element's own Abaqus normal
+    (on SNEG along it; *DLOAD P as SPOS): with element 3 (area 0.5) numbered the other way
+    round (normal -z) and the rest (area 9.5) +z, the resultant along z is
+    -+p (9.5 - 0.5). shellsim orients the mesh one way and splits the load in two, one
+    for each of Abaqus' orientations, with opposite signs."""
+    path = tmp_path / "plate.inp"
+    path.write_text(strip_inp(tip_force=0.0, reversed_elements=(3,), extra_step=step).replace("_Top, SPOS", f"_Top, {face}"))
+    model = read_foreign(path)
+    assert all("*OUTPUT" in line for line in model.unmapped)
+    tables = model.tables | {"geometry": {"builder": "file", "path": str(path)}, "solver": {"end_time": 1.0}}
+    tables["load"] = [t for t in tables["load"] if t["type"] == "pressure"]
+    assert len(tables["load"]) == 2 and {t["value"] for t in tables["load"]} == {2.0, -2.0}
+    deck = parse_deck(deck_text(tables))
+    f, _ = initial_external_forces(build_model(deck, build_mesh(deck)))
+    assert f[:, 2].sum() == pytest.approx(sign * 2.0 * (9.5 - 0.5), rel=1e-9)
+    assert np.abs(f[:, :2].sum(axis=0)).max() <= 1e-12
+
+
+def test_new_mid_edge_nodes_lie_on_a_curved_surface_not_on_its_chords():
+    """A cylinder of radius 1 meshed with 4-node quads 30 degrees apart: the new mid-edge
+    and centre nodes are within 0.2% of the radius (the Hermite curve's error is
+    1 - cos 15 (1 + sin^2 15 / 2) = 0.17%), where chord midpoints fall 3.4% inside; on a
+    flat mesh they are the chord midpoints exactly."""
+    angles = np.radians(np.arange(0, 360, 30))
+    ring = np.column_stack([np.cos(angles), np.sin(angles)])
+    x = np.concatenate([np.column_stack([ring, np.full(12, z)]) for z in (0.0, 0.5, 1.0)])
+    quads = np.asarray([[i + 12 * k, (i + 1) % 12 + 12 * k, (i + 1) % 12 + 12 * (k + 1), i + 12 * (k + 1)]
+                        for k in range(2) for i in range(12)])
+    up = upgrade(x, quads)
+    radius = np.linalg.norm(up.x[36:, :2], axis=1)
+    assert np.abs(radius - 1).max() <= 2e-3
+    chord = 0.5 * np.linalg.norm(ring[0] + ring[1])
+    assert 1 - chord > 0.03
+    flat = upgrade(x[:, [0, 2, 1]] * [1, 1, 0], quads)  # the cylinder's nodes pressed onto z = 0
+    new = flat.x[len(x):len(x) + len(flat.edge_ends)]
+    assert np.allclose(new, flat.x[flat.edge_ends].mean(axis=1), atol=1e-12)
+
+
+def test_what_cannot_come_over_is_listed_with_its_line_and_a_mesh_deck_refuses_it(strip, tmp_path):
+    """Cable elements, a user material, a keyword shellsim does not read and a second step
+    each named with file and line; the import still writes the deck (its problems say
+    what to edit: a material), while a deck reading the file's mesh refuses the cables."""
+    extra_model = "*Element, type=T3D2, elset=Chords\n900, 1, 2\n*Equation\n2\n1, 1, 1., 2, 1, -1."
+    path = strip(extra_model=extra_model)
+    text = path.read_text().replace("*Elastic\n200000., 0.0", "*User Material, constants=2\n1., 2.")
+    path.write_text(text + "*Step\n*Static\n*End Step\n")
+    done = import_model(path, tmp_path / "imported")
+    listed = "\n".join(done.unmapped)
+    for pattern in (r"1 T3D2 element\(s\) \(first at strip\.inp:\d+\)", r"\*USER MATERIAL \(strip\.inp:\d+\).*lee_sacks",
+                    r"\*EQUATION \(strip\.inp:\d+\): not read", r"\*STEP \(strip\.inp:\d+\): only the first step"):
+        assert re.search(pattern, listed), pattern
+    assert any("material" in p for p in done.problems)
+    for line in done.unmapped:
+        assert line in done.deck.read_text()
+    with pytest.raises(MeshError, match=r"T3D2.*strip\.inp:\d+"):
+        read_mesh(path)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("1, 0., 0., 0.\n*Node\n", r"data before the first keyword"),
+    ("*Node\n1, 0., 0.\n*Element, type=S4\n1, 1, 2, 3, 4\n", r"nodes that are not defined: 2"),
+    ("*Node\n1, a, 0., 0.\n", r"bad\.inp:2.*label, x, y, z"),
+    ("*Nset, nset=A\nNowhere\n", r"\*NSET \(bad\.inp:1\): unknown node set 'Nowhere'"),
+    ("*Include, input=missing.inp\n", r"missing\.inp' cannot be read"),
+    ("*Node\n1, 0., 0., 0.\n", r"no shell quadrilaterals"),
+])
+def test_a_broken_input_file_is_refused_naming_its_line(tmp_path, text, message):
+    path = tmp_path / "bad.inp"
+    path.write_text(text)
+    with pytest.raises(MeshError, match=message):
+        read_foreign(path)
+
+
+def test_included_files_per_node_motion_and_symmetry(strip, tmp_path):
+    """The nodes read from an *INCLUDE file; XSYMM on the root as a symmetry plane; a tip
+    pulled by a different value at each node (one *BOUNDARY line per node) as one
+    prescribed motion with a point field, the new tip node between two given ones moving
+    by their mean; a rotation held alone listed."""
+    text = strip_inp()
+    nodes = text[text.index("*Node"):text.index("*Element")]
+    (tmp_path / "nodes.inp").write_text(nodes)
+    text = text.replace(nodes, "*Include, input=nodes.inp\n").replace("Fixed, ENCASTRE", "Fixed, XSYMM\nStrip-1.Tip, 5, 5")
+    text = text.replace("*Output", "*Boundary\nStrip-1.11, 3, 3, 0.1\nStrip-1.22, 3, 3, 0.2\nStrip-1.33, 3, 3, 0.3\n*Output")
+    path = tmp_path / "strip.inp"
+    path.write_text(text)
+    model = read_foreign(path)
+    tables = model.tables
+    symmetry = [b for b in tables["boundary"] if b["type"] == "symmetry"]
+    assert symmetry and symmetry[0]["normal"] == [1.0, 0.0, 0.0]
+    moved, = [b for b in tables["boundary"] if b["type"] == "prescribed"]
+    field = model.mesh.point_fields[moved["field"]]
+    tip = model.mesh.sets[moved["set"]].nodes
+    assert len(tip) == 5
+    assert sorted(np.round(field[tip], 12)) == [0.1, 0.15, 0.2, 0.25, 0.3]
+    assert any("rotation about y alone" in line for line in model.unmapped)
+    # the deck reads the file's mesh itself, and each node moves by its own share
+    tables = model.tables | {"geometry": {"builder": "file", "path": str(path)}}
+    deck = parse_deck(deck_text(tables))
+    mesh = build_mesh(deck)
+    prescribed = build_model(deck, mesh).constraints.prescribed
+    assert sorted(np.round(prescribed.values, 12)) == [0.1, 0.15, 0.2, 0.25, 0.3]
+    assert np.array_equal(np.sort(prescribed.nodes), np.sort(mesh.sets[moved["set"]].nodes))
+    wrong = parse_deck(deck_text(tables | {"boundary": [moved | {"field": "nowhere"}]}))
+    with pytest.raises(MeshError, match=r"boundary set 'moved_z': field 'nowhere' is not a scalar point field.*'moved_z'"):
+        build_model(wrong, build_mesh(wrong))
+
+
+def test_hgo_constants_and_fibre_axes_from_a_distribution(strip, tmp_path):
+    """*ANISOTROPIC HYPERELASTIC, HOLZAPFEL (C10, D, k1, k2, kappa) as hgo with mu = 2 C10,
+    the families at +-beta from the orientation's two local directions, material axis 1
+    per element from a *DISTRIBUTION (default row and one element's own)."""
+    text = strip_inp().replace("*Elastic\n200000., 0.0",
+                               "*Anisotropic Hyperelastic, holzapfel, local directions=2\n0.0035, 0., 2.3632, 0.8393, 0.226")
+    text = text.replace("*Shell Section, elset=Whole, material=Steel",
+                        "*Distribution, name=Fibres, location=ELEMENT, Table=T\n, 1., 0., 0., 0., 1., 0.\n"
+                        "7, 0., 1., 0., -1., 0., 0.\n*Orientation, name=Ori, local directions=2\nFibres\n3, 0.\n"
+                        "0.7660444, 0.6427876, 0.\n0.7660444, -0.6427876, 0.\n"
+                        "*Shell Section, elset=Whole, material=Steel, orientation=Ori")
+    path = tmp_path / "hgo.inp"
+    path.write_text(text)
+    model = read_foreign(path)
+    material = model.tables["material"]
+    assert material["model"] == "hgo" and material["mu"] == pytest.approx(0.007)
+    assert (material["k1"], material["k2"], material["kappa"]) == (2.3632, 0.8393, 0.226)
+    assert material["beta_deg"] == pytest.approx(40.0, abs=1e-5)
+    assert material["axes"] == {"kind": "mesh", "field": "Fibres"}
+    vectors = model.mesh.cell_vectors["Fibres"]
+    assert np.allclose(vectors[6], [0, 1, 0]) and np.allclose(np.delete(vectors, 6, axis=0), [1, 0, 0])
+
+
+def test_shellsim_import_writes_a_deck_that_checks(strip, tmp_path):
+    """The command: the deck and mesh written, the unmapped lines shown, ``check`` passes on
+    the deck; a second import into the same folder is refused, the first deck kept."""
+    runner = CliRunner()
+    out = tmp_path / "imported"
+    result = runner.invoke(app, ["import", str(strip()), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "not brought over" in result.output and (out / "deck.toml").is_file() and (out / "strip.vtu").is_file()
+    assert runner.invoke(app, ["check", str(out / "deck.toml")]).exit_code == 0
+    before = (out / "deck.toml").read_text()
+    again = runner.invoke(app, ["import", str(strip()), "--out", str(out)])
+    assert again.exit_code == 2 and "exists" in again.output and (out / "deck.toml").read_text() == before

@@ -14,7 +14,7 @@ from shellsim.cli import app
 from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import MeshError
 from shellsim.foreign import read_foreign
-from shellsim.foreign.quad_upgrade import upgrade
+from shellsim.foreign.quad_upgrade import split, upgrade
 from shellsim.foreign.writing import deck_text, import_model
 from shellsim.geometry import build_mesh
 from shellsim.geometry.importing import read_mesh
@@ -24,26 +24,33 @@ from .conftest import initial_external_forces, run_deck
 
 
 def strip_inp(tip_force: float = -1e-3, extra_model: str = "", extra_step: str = "", reversed_elements: tuple = (),
-              nx: int = 10, ny: int = 2) -> str:
+              triangles: int = 0, nx: int = 10, ny: int = 2) -> str:
     """An Abaqus input of a cantilever strip as CAE writes one: a part of S4R elements
     placed by an instance shifted 5 along x, an assembly-level node set clamped, a force
     on each tip node ramped by an amplitude in a static step. L = 10, b = 1, t = 0.1,
     E = 2e5, nu = 0; ``extra_model`` and ``extra_step`` lines go before the first
-    *BOUNDARY and at the step's end, elements ``reversed_elements`` are numbered clockwise."""
+    *BOUNDARY and at the step's end, elements ``reversed_elements`` are numbered clockwise,
+    the first ``triangles`` cut into two S3R triangles each."""
     length, width = 10.0, 1.0
     nodes = [(1 + i + j * (nx + 1), i * length / nx, j * width / ny) for j in range(ny + 1) for i in range(nx + 1)]
     lines = ["*Heading", " Cantilever strip, S4R, tip load", "** a comment", "*Part, name=Strip", "*Node"]
     lines += [f"{n}, {x!r}, {y!r}, 0." for n, x, y in nodes]
-    lines += ["*Element, type=S4R"]
+    quads, cut = ["*Element, type=S4R"], ["*Element, type=S3R"]
     for j in range(ny):
         for i in range(nx):
             n1 = 1 + i + j * (nx + 1)
             corners = [n1, n1 + 1, n1 + nx + 2, n1 + nx + 1]
             label = 1 + i + j * nx
-            lines.append(", ".join(map(str, [label] + (corners[::-1] if label in reversed_elements else corners))))
+            corners = corners[::-1] if label in reversed_elements else corners
+            if label <= triangles:
+                cut += [", ".join(map(str, [label] + corners[:3])), ", ".join(map(str, [1000 + label] + corners[2:] + corners[:1]))]
+            else:
+                quads.append(", ".join(map(str, [label] + corners)))
+    lines += quads + (cut if triangles else [])
     lines += ["*Nset, nset=Root", ", ".join(str(n) for n, x, _ in nodes if x == 0.0) + ",",
               "*Nset, nset=Tip", ", ".join(str(n) for n, x, _ in nodes if x == length),
-              "*Elset, elset=Whole, generate", f"1, {nx * ny}, 1",
+              "*Elset, elset=Whole, generate", f"1, {nx * ny}, 1"] + (
+                  ["*Elset, elset=Whole, generate", f"1001, {1000 + triangles}, 1"] if triangles else []) + [
               "*Shell Section, elset=Whole, material=Steel", "0.1, 5", "*End Part",
               "*Assembly, name=Assembly", "*Instance, name=Strip-1, part=Strip", "5., 0., 0.", "*End Instance",
               "*Nset, nset=Fixed, instance=Strip-1", "Root,",
@@ -85,6 +92,28 @@ component = "z"
     assert run.status == "completed"
     total, inertia = 3 * 1e-3, 1.0 * 0.1**3 / 12
     exact = -total * 10.0**3 / (3 * 2e5 * inertia)
+    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+
+
+def test_triangles_split_into_quads_still_bend_as_beam_theory_says(tmp_path):
+    """Half the strip's elements as S3R triangles (two per square): each triangle split
+    into three quads and each quad into four so that they meet, 100 elements in all; the
+    tip deflection is still P L^3 / (3 E I) within 0.5%, the split listed."""
+    path = tmp_path / "strip.inp"
+    path.write_text(strip_inp(triangles=10))
+    done = import_model(path, tmp_path / "imported")
+    assert done.problems == [] and done.elements == 20 * 3 + 10 * 4
+    assert any(re.search(r"20 triangle\(s\) \(first at strip\.inp:\d+\): each split into three quads", line)
+               for line in done.unmapped)
+    done.deck.write_text(done.deck.read_text() + '''
+[[output.probe]]
+name = "tip"
+quantity = "displacement"
+set = "Strip-1_Tip"
+component = "z"
+''')
+    run = run_deck(load_deck(done.deck), done.deck.parent)
+    exact = -3e-3 * 10.0**3 / (3 * 2e5 * 0.1**3 / 12)
     assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
 
 
@@ -135,8 +164,10 @@ def test_pressure_pushes_where_abaqus_pushes_whichever_way_elements_were_numbere
 def test_new_mid_edge_nodes_lie_on_a_curved_surface_not_on_its_chords():
     """A cylinder of radius 1 meshed with 4-node quads 30 degrees apart: the new mid-edge
     and centre nodes are within 0.2% of the radius (the Hermite curve's error is
-    1 - cos 15 (1 + sin^2 15 / 2) = 0.17%), where chord midpoints fall 3.4% inside; on a
-    flat mesh they are the chord midpoints exactly."""
+    1 - cos 15 (1 + sin^2 15 / 2) = 0.17%), where chord midpoints fall 3.4% inside; so
+    are those of its lower half cut into triangles, split with the upper half's quads
+    (the nodes the pieces then gain, between those, within 0.25%); on a flat mesh the
+    new nodes are the chord midpoints exactly."""
     angles = np.radians(np.arange(0, 360, 30))
     ring = np.column_stack([np.cos(angles), np.sin(angles)])
     x = np.concatenate([np.column_stack([ring, np.full(12, z)]) for z in (0.0, 0.5, 1.0)])
@@ -147,6 +178,11 @@ def test_new_mid_edge_nodes_lie_on_a_curved_surface_not_on_its_chords():
     assert np.abs(radius - 1).max() <= 2e-3
     chord = 0.5 * np.linalg.norm(ring[0] + ring[1])
     assert 1 - chord > 0.03
+    pieces, parent = split(x, np.concatenate([quads[:12, :3], quads[:12, [2, 3, 0]]]), quads[12:])
+    fine = upgrade(pieces.x, pieces.conn)
+    assert len(fine.conn) == 24 * 3 + 12 * 4 and np.array_equal(np.bincount(parent), [3] * 24 + [4] * 12)
+    assert np.abs(np.linalg.norm(pieces.x[36:, :2], axis=1) - 1).max() <= 2e-3
+    assert np.abs(np.linalg.norm(fine.x[36:, :2], axis=1) - 1).max() <= 2.5e-3  # the pieces' nodes lean on those
     flat = upgrade(x[:, [0, 2, 1]] * [1, 1, 0], quads)  # the cylinder's nodes pressed onto z = 0
     new = flat.x[len(x):len(x) + len(flat.edge_ends)]
     assert np.allclose(new, flat.x[flat.edge_ends].mean(axis=1), atol=1e-12)
@@ -178,7 +214,7 @@ def test_what_cannot_come_over_is_listed_with_its_line_and_a_mesh_deck_refuses_i
     ("*Node\n1, a, 0., 0.\n", r"bad\.inp:2.*label, x, y, z"),
     ("*Nset, nset=A\nNowhere\n", r"\*NSET \(bad\.inp:1\): unknown node set 'Nowhere'"),
     ("*Include, input=missing.inp\n", r"missing\.inp' cannot be read"),
-    ("*Node\n1, 0., 0., 0.\n", r"no shell quadrilaterals"),
+    ("*Node\n1, 0., 0., 0.\n", r"no shell elements shellsim reads"),
 ])
 def test_a_broken_input_file_is_refused_naming_its_line(tmp_path, text, message):
     path = tmp_path / "bad.inp"

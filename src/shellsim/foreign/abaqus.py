@@ -1,6 +1,7 @@
 """An Abaqus shell model as a shellsim mesh and deck tables.
 
-Shells (S4, S4R, S8R, S9R5 and their variants) become 9-node quads (:mod:`.quad_upgrade`),
+Shells (S4, S4R, S8R, S9R5 and their variants) become 9-node quads (:mod:`.quad_upgrade`;
+triangles S3, S3R split into quads first),
 their node and element sets and element-based surfaces named sets, ``*ORIENTATION`` (with
 per-element ``*DISTRIBUTION``) material axes; the model data and the first step become the
 deck's material, section, boundaries, loads, contact, curves and solver. Every keyword,
@@ -20,18 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import MeshError, id_list
+from ..errors import SHOWN_IDS, MeshError
 from ..geometry.importing import ImportedMesh
 from ..mesh import NamedSet, averaged_directors, edges_within, element_normals, orient_consistently
 from . import ForeignModel
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
-from .quad_upgrade import upgrade
+from .quad_upgrade import split, upgrade
 
 #: Abaqus shell types by their number of nodes.
-SHELLS = {4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"}, 9: {"S9R5"}}
+SHELLS = {3: {"S3", "S3R", "S3RS", "STRI3"}, 4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"},
+          9: {"S9R5"}}
 #: Why other element types cannot come over.
 NOT_SHELLS = {
-    "S3": "triangles: remesh the surface into quads (e.g. write it as STL for geometry.surface)",
+    "STRI65": "6-node triangles: bring them as 3-node ones (S3)",
     "T3D2": "line elements (cables, chordae) are not yet shellsim elements",
     "B31": "beam elements are not shellsim elements",
     "M3D4": "membranes: shellsim's shells carry bending; model the membrane as a thin shell",
@@ -88,31 +90,41 @@ class _Builder:
         m.unmapped.extend(self.unused_elements)
         orders = [size for size, elements in shells.items() if elements]
         if not orders:
-            raise MeshError(f"model file '{m.path}' has no shell quadrilaterals shellsim reads "
+            raise MeshError(f"model file '{m.path}' has no shell elements shellsim reads "
                             f"({', '.join(sorted(set().union(*SHELLS.values())))}); found "
                             f"{', '.join(sorted(by_kind)) or 'no elements'}")
-        if len(orders) > 1:
+        if len(orders) > 1 and orders != [3, 4]:
             raise MeshError(f"model file '{m.path}' mixes shells of {' and '.join(map(str, orders))} nodes; "
                             "bring them to one order before importing")
-        self.elements = shells[orders[0]]
+        self.elements = [e for size in orders for e in shells[size]]
         labels = [label for e in self.elements for label in e.nodes]
         missing = sorted({label for label in labels if label not in m.nodes})
         if missing:
             raise MeshError(f"model file '{m.path}': elements use nodes that are not defined: {', '.join(missing[:5])}")
         for e in self.elements:
-            if len(e.nodes) != orders[0] or len(set(e.nodes)) != orders[0]:
+            size = next(size for size, kinds in SHELLS.items() if e.kind in kinds)
+            if len(e.nodes) != size or len(set(e.nodes)) != size:
                 raise MeshError(f"model file '{m.path}', element {e.label} ({e.where}): a {e.kind} has "
-                                f"{orders[0]} distinct nodes; got {', '.join(e.nodes)}")
+                                f"{size} distinct nodes; got {', '.join(e.nodes)}")
         used = sorted({m.nodes[label] for label in labels})
         position = {i: j for j, i in enumerate(used)}
         self.index_of_label = {label: position[i] for label, i in m.nodes.items() if i in position}
         x = np.asarray([m.coords[i] for i in used])
-        quads = np.asarray([[self.index_of_label[n] for n in e.nodes] for e in self.elements], dtype=np.int64)
-        if orders[0] == 9:
-            x9, conn = x, quads
-            self.lift = lambda nodes: np.unique(nodes)
+        corners = {size: np.asarray([[self.index_of_label[n] for n in e.nodes] for e in shells[size]],
+                                    dtype=np.int64).reshape(-1, size) for size in orders}
+        self.parent = np.arange(len(self.elements))  # each shellsim element's Abaqus element
+        if orders == [9]:
+            x9, conn, self.lift = x, corners[9], np.unique
+        elif orders[0] == 3:  # triangles: every element split into quads first
+            pieces, self.parent = split(x, corners[3], corners.get(4, np.zeros((0, 4), dtype=np.int64)))
+            upgraded = upgrade(pieces.x, pieces.conn)
+            x9, conn = upgraded.x, upgraded.conn
+            self.lift = lambda nodes: upgraded.lift(pieces.lift(nodes))
+            m.unmapped.append(f"{len(shells[3])} triangle(s) (first at {shells[3][0].where}): each split into three "
+                              "quads" + (", and each quad into four, so that they meet the triangles' pieces"
+                                         if 4 in orders else ""))
         else:
-            upgraded = upgrade(x, quads)
+            upgraded = upgrade(x, corners[orders[0]])
             x9, conn, self.lift = upgraded.x, upgraded.conn, upgraded.lift
         abaqus_normals = element_normals(x9, conn, np.zeros((1, 2)))[:, 0]
         self.conn = orient_consistently(x9, conn, abaqus_normals)
@@ -120,7 +132,10 @@ class _Builder:
         self.side = np.where((self.conn == conn).all(axis=1), 1.0, -1.0)
         self.x = x9
         self.director = averaged_directors(x9, self.conn)
-        self.element_of_label = {e.label: i for i, e in enumerate(self.elements)}
+        pieces_of = defaultdict(list)
+        for piece, parent in enumerate(self.parent):
+            pieces_of[self.elements[parent].label].append(piece)
+        self.pieces_of = {label: np.asarray(p) for label, p in pieces_of.items()}
         self._named_sets()
 
     def _named_sets(self) -> None:
@@ -149,8 +164,12 @@ class _Builder:
                 self._name(("surface", key), named.name, self._surface_set(elements))
 
     def _elements(self, labels) -> np.ndarray:
-        return np.unique([self.element_of_label[label] for label in labels if label in self.element_of_label]
-                         ).astype(np.int64)
+        pieces = [self.pieces_of[label] for label in labels if label in self.pieces_of]
+        return np.unique(np.concatenate(pieces)).astype(np.int64) if pieces else np.zeros(0, dtype=np.int64)
+
+    def _labels(self, chosen: np.ndarray) -> list[str]:
+        """The Abaqus labels of the elements the pieces ``chosen`` (mask) come from."""
+        return list(dict.fromkeys(self.elements[p].label for p in self.parent[chosen]))
 
     def _nodes(self, labels, lift: bool = True) -> np.ndarray:
         """The mesh nodes of node ``labels`` and, with ``lift``, the new nodes they span."""
@@ -209,8 +228,8 @@ class _Builder:
     # -- material and section ---------------------------------------------------------------
     def material_and_section(self) -> None:
         m = self.model
-        covered = np.zeros(len(self.elements), dtype=bool)
-        thickness = np.full(len(self.elements), np.nan)
+        covered = np.zeros(len(self.conn), dtype=bool)
+        thickness = np.full(len(self.conn), np.nan)
         chosen = None
         for k, elset, prefix in m.sections:
             elements = self._elements(m.elsets[elset].items)
@@ -227,16 +246,22 @@ class _Builder:
             if chosen is None:
                 chosen = (material, k, prefix)
             elif material != chosen[0]:
+                mask = np.zeros(len(self.conn), dtype=bool)
+                mask[elements] = True
                 m.unmapped.append(f"{k.label()}: material '{k.param('material')}' on elements "
-                                  f"{id_list(elements + 1)}: a deck has one material; '{chosen[1].param('material')}' "
-                                  "is used everywhere")
-            for option in ("offset", "nodal thickness", "shell thickness"):
+                                  f"{_listed(self._labels(mask))}: a deck has one material; "
+                                  f"'{chosen[1].param('material')}' is used everywhere")
+            offset = (k.param("offset") or "0").upper()
+            if offset not in ("MIDDLE", "SMID") and not (_is_number(offset) and float(offset) == 0.0):
+                m.unmapped.append(f"{k.label()}: OFFSET={k.param('offset')} is not read (shellsim's reference surface "
+                                  "is the mid-surface)")
+            for option in ("nodal thickness", "shell thickness"):
                 if option in k.params:
                     m.unmapped.append(f"{k.label()}: {option.upper()} is not read (shellsim's reference surface is "
                                       "the mid-surface; thickness is [section] thickness)")
         if not covered.all():
             raise MeshError(f"model file '{m.path}': shell elements without a shell section: "
-                            f"{id_list([e.label for e, c in zip(self.elements, covered) if not c])}")
+                            f"{_listed(self._labels(~covered))}")
         if chosen is None:
             raise MeshError(f"model file '{m.path}' has no *SHELL SECTION")
         values, counts = np.unique(thickness, return_counts=True)
@@ -365,20 +390,20 @@ class _Builder:
         k, own = self.model.distributions[self.model.key_of(self.model.distributions, name, prefix, where,
                                                                "distribution")]
         default = None
-        vectors = np.full((len(self.elements), 3), np.nan)
+        vectors = np.full((len(self.conn), 3), np.nan)
         for row in k.rows:
             values = np.asarray([float(v) for v in row[1:4]])
             if row[0] == "":
                 default = values
                 continue
             for label in self.model.element_labels(row[0], own, k):
-                if label in self.element_of_label:
-                    vectors[self.element_of_label[label]] = values
+                if label in self.pieces_of:
+                    vectors[self.pieces_of[label]] = values
         if default is not None:
             vectors[np.isnan(vectors).any(axis=1)] = default
         if np.isnan(vectors).any():
-            missing = [e.label for e, v in zip(self.elements, vectors) if np.isnan(v).any()]
-            raise MeshError(f"{k.label()}: no direction for elements {id_list(missing)} (and no default row)")
+            missing = self._labels(np.isnan(vectors).any(axis=1))
+            raise MeshError(f"{k.label()}: no direction for elements {_listed(missing)} (and no default row)")
         field = re.sub(r"[^A-Za-z0-9_\-]", "_", k.param("name") or "orientation")
         field = field if field[:1].isalpha() else "axis" + field
         self.cell_vectors[field] = vectors
@@ -604,8 +629,7 @@ class _Builder:
             if surface.kind == "node":
                 self.model.unmapped.append(f"{k.label()}: pressure on the node-based surface '{token}' is not read")
                 return []
-            faces = [(self.element_of_label[label], side) for label, side in surface.items
-                     if label in self.element_of_label]
+            faces = [(piece, side) for label, side in surface.items for piece in self.pieces_of.get(label, [])]
             if any(side not in ("SPOS", "SNEG") for _, side in faces):
                 self.model.unmapped.append(f"{k.label()}: surface '{token}' has faces that are neither SPOS nor SNEG; "
                                            "read as SPOS")
@@ -701,6 +725,12 @@ class _Builder:
                 m.unmapped.append(f"{k.label()}: implicit dynamics: shellsim integrates the step explicitly")
             solver = {"method": "explicit", "end_time": row[1] or 1.0}
         self.tables["solver"] = solver
+
+
+def _listed(labels: list[str]) -> str:
+    """Labels for a message: 'strip-1.3, strip-1.4 and 12 more'."""
+    shown = ", ".join(labels[:SHOWN_IDS])
+    return shown + (f" and {len(labels) - SHOWN_IDS} more" if len(labels) > SHOWN_IDS else "")
 
 
 def _is_number(text: str) -> bool:

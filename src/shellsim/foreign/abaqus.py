@@ -15,18 +15,16 @@ on the mid-surface, Abaqus' reference surface, as ``face = "mid"`` with the oppo
 
 from __future__ import annotations
 
-import re
 from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import SHOWN_IDS, MeshError
+from ..errors import MeshError
 from ..geometry.importing import ImportedMesh
-from ..mesh import NamedSet, averaged_directors, edges_within, element_normals, orient_consistently
 from . import ForeignModel
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
-from .quad_upgrade import split, upgrade
+from .shell_mesh import ShellMesh, deck_name, listed
 
 #: Abaqus shell types by their number of nodes.
 SHELLS = {3: {"S3", "S3R", "S3RS", "STRI3"}, 4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"},
@@ -67,12 +65,7 @@ class _Builder:
         self.model = model
         self.tables: dict = {}
         self.unused_elements: list[str] = []
-        self.sets: dict[str, NamedSet] = {}
-        self.set_of: dict[tuple[str, str], str] = {}  # (what, abaqus key) -> deck set name
         self.curve_of: dict[str, str] = {}  # amplitude key -> curve name
-        self.point_fields: dict[str, np.ndarray] = {}
-        self.cell_vectors: dict[str, np.ndarray] = {}
-        self.thickness: np.ndarray | None = None
         self.density: float | None = None
 
     # -- mesh -------------------------------------------------------------------------------
@@ -93,111 +86,41 @@ class _Builder:
             raise MeshError(f"model file '{m.path}' has no shell elements shellsim reads "
                             f"({', '.join(sorted(set().union(*SHELLS.values())))}); found "
                             f"{', '.join(sorted(by_kind)) or 'no elements'}")
-        if len(orders) > 1 and orders != [3, 4]:
-            raise MeshError(f"model file '{m.path}' mixes shells of {' and '.join(map(str, orders))} nodes; "
-                            "bring them to one order before importing")
-        self.elements = [e for size in orders for e in shells[size]]
-        labels = [label for e in self.elements for label in e.nodes]
-        missing = sorted({label for label in labels if label not in m.nodes})
-        if missing:
-            raise MeshError(f"model file '{m.path}': elements use nodes that are not defined: {', '.join(missing[:5])}")
-        for e in self.elements:
+        elements = [e for size in orders for e in shells[size]]
+        for e in elements:
             size = next(size for size, kinds in SHELLS.items() if e.kind in kinds)
-            if len(e.nodes) != size or len(set(e.nodes)) != size:
+            if len(e.nodes) != size:
                 raise MeshError(f"model file '{m.path}', element {e.label} ({e.where}): a {e.kind} has "
-                                f"{size} distinct nodes; got {', '.join(e.nodes)}")
-        used = sorted({m.nodes[label] for label in labels})
-        position = {i: j for j, i in enumerate(used)}
-        self.index_of_label = {label: position[i] for label, i in m.nodes.items() if i in position}
-        x = np.asarray([m.coords[i] for i in used])
-        corners = {size: np.asarray([[self.index_of_label[n] for n in e.nodes] for e in shells[size]],
-                                    dtype=np.int64).reshape(-1, size) for size in orders}
-        self.parent = np.arange(len(self.elements))  # each shellsim element's Abaqus element
-        if orders == [9]:
-            x9, conn, self.lift = x, corners[9], np.unique
-        elif orders[0] == 3:  # triangles: every element split into quads first
-            pieces, self.parent = split(x, corners[3], corners.get(4, np.zeros((0, 4), dtype=np.int64)))
-            upgraded = upgrade(pieces.x, pieces.conn)
-            x9, conn = upgraded.x, upgraded.conn
-            self.lift = lambda nodes: upgraded.lift(pieces.lift(nodes))
-            m.unmapped.append(f"{len(shells[3])} triangle(s) (first at {shells[3][0].where}): each split into three "
-                              "quads" + (", and each quad into four, so that they meet the triangles' pieces"
-                                         if 4 in orders else ""))
-        else:
-            upgraded = upgrade(x, corners[orders[0]])
-            x9, conn, self.lift = upgraded.x, upgraded.conn, upgraded.lift
-        abaqus_normals = element_normals(x9, conn, np.zeros((1, 2)))[:, 0]
-        self.conn = orient_consistently(x9, conn, abaqus_normals)
-        # +1 where the element kept Abaqus' positive normal, -1 where orienting turned it
-        self.side = np.where((self.conn == conn).all(axis=1), 1.0, -1.0)
-        self.x = x9
-        self.director = averaged_directors(x9, self.conn)
-        pieces_of = defaultdict(list)
-        for piece, parent in enumerate(self.parent):
-            pieces_of[self.elements[parent].label].append(piece)
-        self.pieces_of = {label: np.asarray(p) for label, p in pieces_of.items()}
+                                f"{size} nodes; got {', '.join(e.nodes)}")
+        positions = {label: m.coords[i] for label, i in m.nodes.items()}
+        self.shells = ShellMesh(m.path, positions, [(e.label, e.nodes, e.where) for e in elements])
+        m.unmapped.extend(self.shells.notes)
         self._named_sets()
 
     def _named_sets(self) -> None:
         m = self.model
         for key, named in m.elsets.items():
-            elements = self._elements(named.items)
+            elements = self.shells.elements_of(named.items)
             if len(elements):
-                self._name(("elset", key), named.name, self._surface_set(elements))
+                self.shells.add_set(("elset", key), named.name, self.shells.surface_set(elements))
         for key, named in m.nsets.items():
-            nodes = self._nodes(named.items)
+            nodes = self.shells.nodes_of(named.items)
             if not len(nodes):
                 continue
-            twin = self.set_of.get(("elset", key))
-            if twin is not None and np.array_equal(self.sets[twin].nodes, nodes):
-                self.set_of[("nset", key)] = twin  # CAE writes a region as an nset and an elset alike
+            twin = self.shells.set_of.get(("elset", key))
+            if twin is not None and np.array_equal(self.shells.sets[twin].nodes, nodes):
+                self.shells.set_of[("nset", key)] = twin  # CAE writes a region as an nset and an elset alike
             else:
-                self._name(("nset", key), named.name + ("_nodes" if twin else ""), self._node_set(nodes))
+                self.shells.add_set(("nset", key), named.name + ("_nodes" if twin else ""), self.shells.node_set(nodes))
         for key, named in m.surfaces.items():
             if named.kind == "node":
-                nodes = self._nodes([label for label, _ in named.items])
+                nodes = self.shells.nodes_of([label for label, _ in named.items])
                 if len(nodes):
-                    self._name(("surface", key), named.name, self._node_set(nodes))
+                    self.shells.add_set(("surface", key), named.name, self.shells.node_set(nodes))
                 continue
-            elements = self._elements([label for label, _ in named.items])
+            elements = self.shells.elements_of([label for label, _ in named.items])
             if len(elements):
-                self._name(("surface", key), named.name, self._surface_set(elements))
-
-    def _elements(self, labels) -> np.ndarray:
-        pieces = [self.pieces_of[label] for label in labels if label in self.pieces_of]
-        return np.unique(np.concatenate(pieces)).astype(np.int64) if pieces else np.zeros(0, dtype=np.int64)
-
-    def _labels(self, chosen: np.ndarray) -> list[str]:
-        """The Abaqus labels of the elements the pieces ``chosen`` (mask) come from."""
-        return list(dict.fromkeys(self.elements[p].label for p in self.parent[chosen]))
-
-    def _nodes(self, labels, lift: bool = True) -> np.ndarray:
-        """The mesh nodes of node ``labels`` and, with ``lift``, the new nodes they span."""
-        given = np.unique([self.index_of_label[label] for label in labels if label in self.index_of_label])
-        return self.lift(given.astype(np.int64)) if len(given) and lift else given.astype(np.int64)
-
-    def _surface_set(self, elements: np.ndarray) -> NamedSet:
-        return NamedSet("surface", np.unique(self.conn[elements]), elements=elements)
-
-    def _node_set(self, nodes: np.ndarray) -> NamedSet:
-        edges = edges_within(self.conn, nodes)
-        if len(nodes) > 1 and len(edges):
-            return NamedSet("edge", nodes, edges=edges)
-        return NamedSet("point", nodes)
-
-    def _name(self, key: tuple[str, str] | None, wanted: str, named: NamedSet) -> str:
-        """Add ``named`` under a deck name made from ``wanted`` (deck names: a letter, then
-        letters, digits, '_' or '-'), unique; remember it under ``key``."""
-        name = re.sub(r"[^A-Za-z0-9_\-]", "_", wanted)
-        name = name if name[:1].isalpha() else "set" + name
-        base, count = name, 1
-        while name.lower() in {n.lower() for n in self.sets}:
-            count += 1
-            name = f"{base}_{count}"
-        self.sets[name] = named
-        if key is not None:
-            self.set_of[key] = name
-        return name
+                self.shells.add_set(("surface", key), named.name, self.shells.surface_set(elements))
 
     def node_set_for(self, k: Keyword, tokens: list[str], wanted: str) -> str:
         """The deck set of the nodes a data line's fields name: the named set itself when
@@ -208,31 +131,22 @@ class _Builder:
                     key = self.model.key_of(table, tokens[0], "", k, "node set")
                 except MeshError:
                     continue
-                if (what, key) in self.set_of:
-                    return self.set_of[(what, key)]
-        return self.new_node_set(k, [label for token in dict.fromkeys(tokens)
-                                     for label in self.model.node_labels(token, "", k)], wanted)
-
-    def new_node_set(self, k: Keyword, labels: list[str], wanted: str, lift: bool = True) -> str:
-        """A new deck set ``wanted`` of the nodes with the (qualified) ``labels`` (and, with
-        ``lift``, the new nodes between them)."""
-        nodes = self._nodes(labels, lift)
-        if not len(nodes):
-            raise MeshError(f"{k.label()}: names no node of a shell element")
-        return self._name(None, wanted, self._node_set(nodes))
+                if (what, key) in self.shells.set_of:
+                    return self.shells.set_of[(what, key)]
+        return self.shells.new_node_set([label for token in dict.fromkeys(tokens)
+                                         for label in self.model.node_labels(token, "", k)], wanted, k.label())
 
     def imported(self) -> ImportedMesh:
-        return ImportedMesh(self.x, self.conn, self.sets, self.director, self.thickness, self.cell_vectors,
-                            self.point_fields, {})
+        return self.shells.imported()
 
     # -- material and section ---------------------------------------------------------------
     def material_and_section(self) -> None:
         m = self.model
-        covered = np.zeros(len(self.conn), dtype=bool)
-        thickness = np.full(len(self.conn), np.nan)
+        covered = np.zeros(len(self.shells.conn), dtype=bool)
+        thickness = np.full(len(self.shells.conn), np.nan)
         chosen = None
         for k, elset, prefix in m.sections:
-            elements = self._elements(m.elsets[elset].items)
+            elements = self.shells.elements_of(m.elsets[elset].items)
             if k.name != "shell section":
                 m.unmapped.append(f"{k.label()}: a {k.name} is not a shellsim section; its elements are left without one")
                 continue
@@ -246,10 +160,10 @@ class _Builder:
             if chosen is None:
                 chosen = (material, k, prefix)
             elif material != chosen[0]:
-                mask = np.zeros(len(self.conn), dtype=bool)
+                mask = np.zeros(len(self.shells.conn), dtype=bool)
                 mask[elements] = True
                 m.unmapped.append(f"{k.label()}: material '{k.param('material')}' on elements "
-                                  f"{_listed(self._labels(mask))}: a deck has one material; "
+                                  f"{listed(self.shells.labels_of(mask))}: a deck has one material; "
                                   f"'{chosen[1].param('material')}' is used everywhere")
             offset = (k.param("offset") or "0").upper()
             if offset not in ("MIDDLE", "SMID") and not (_is_number(offset) and float(offset) == 0.0):
@@ -261,17 +175,17 @@ class _Builder:
                                       "the mid-surface; thickness is [section] thickness)")
         if not covered.all():
             raise MeshError(f"model file '{m.path}': shell elements without a shell section: "
-                            f"{_listed(self._labels(~covered))}")
+                            f"{listed(self.shells.labels_of(~covered))}")
         if chosen is None:
             raise MeshError(f"model file '{m.path}' has no *SHELL SECTION")
         values, counts = np.unique(thickness, return_counts=True)
         section: dict = {"thickness": float(values[counts.argmax()])}  # the mesh file's nodal values rule where they differ
         if len(values) > 1:  # nodal thickness, each node the mean of its elements' thicknesses
-            total = np.zeros(len(self.x))
-            count = np.zeros(len(self.x))
-            np.add.at(total, self.conn, thickness[:, None])
-            np.add.at(count, self.conn, 1.0)
-            self.thickness = total / count
+            total = np.zeros(len(self.shells.x))
+            count = np.zeros(len(self.shells.x))
+            np.add.at(total, self.shells.conn, thickness[:, None])
+            np.add.at(count, self.shells.conn, 1.0)
+            self.shells.thickness = total / count
         material = self._material(*chosen)
         if material is not None:
             if material["model"] != "linear_elastic" or "nlgeom" in self._step_params():
@@ -390,23 +304,22 @@ class _Builder:
         k, own = self.model.distributions[self.model.key_of(self.model.distributions, name, prefix, where,
                                                                "distribution")]
         default = None
-        vectors = np.full((len(self.conn), 3), np.nan)
+        vectors = np.full((len(self.shells.conn), 3), np.nan)
         for row in k.rows:
             values = np.asarray([float(v) for v in row[1:4]])
             if row[0] == "":
                 default = values
                 continue
             for label in self.model.element_labels(row[0], own, k):
-                if label in self.pieces_of:
-                    vectors[self.pieces_of[label]] = values
+                if label in self.shells.pieces_of:
+                    vectors[self.shells.pieces_of[label]] = values
         if default is not None:
             vectors[np.isnan(vectors).any(axis=1)] = default
         if np.isnan(vectors).any():
-            missing = self._labels(np.isnan(vectors).any(axis=1))
-            raise MeshError(f"{k.label()}: no direction for elements {_listed(missing)} (and no default row)")
-        field = re.sub(r"[^A-Za-z0-9_\-]", "_", k.param("name") or "orientation")
-        field = field if field[:1].isalpha() else "axis" + field
-        self.cell_vectors[field] = vectors
+            missing = self.shells.labels_of(np.isnan(vectors).any(axis=1))
+            raise MeshError(f"{k.label()}: no direction for elements {listed(missing)} (and no default row)")
+        field = deck_name(k.param("name") or "orientation", "axis")
+        self.shells.cell_vectors[field] = vectors
         return field
 
     # -- curves -----------------------------------------------------------------------------
@@ -426,8 +339,7 @@ class _Builder:
                 continue
             if (k.param("value") or "relative").lower() == "absolute":
                 self.model.unmapped.append(f"{k.label()}: VALUE=ABSOLUTE: in shellsim a curve scales the load's value")
-            name = re.sub(r"[^A-Za-z0-9_\-]", "_", k.param("name") or "amplitude")
-            name = name if name[:1].isalpha() else "curve" + name
+            name = deck_name(k.param("name") or "amplitude", "curve")
             curve = {"t": t, "value": a}
             if definition == "smooth step":
                 curve["interpolate"] = "smooth"
@@ -544,25 +456,18 @@ class _Builder:
         table = {"type": "prescribed", "set": name, "translation": AXES[dof - 1]} | self._curve(k)
         if len(distinct) == 1:
             return table | {"value": distinct[0]}
-        field = np.zeros(len(self.x))
-        given = {self.index_of_label[label]: v for label, v in values.items() if label in self.index_of_label}
+        field = np.zeros(len(self.shells.x))
+        given = {self.shells.index_of_label[label]: v for label, v in values.items() if label in self.shells.index_of_label}
         field[list(given)] = list(given.values())
         # a new mid-edge node moves as the mean of its corners (its corners are both given)
-        nodes = self.sets[name].nodes
-        known = np.zeros(len(self.x), dtype=bool)
+        nodes = self.shells.sets[name].nodes
+        known = np.zeros(len(self.shells.x), dtype=bool)
         known[list(given)] = True
         for node in nodes[~known[nodes]]:
-            corners = self._corners_of(node)
+            corners = self.shells.corners_of(node)
             field[node] = field[corners].mean()
-        self.point_fields[name] = field
+        self.shells.point_fields[name] = field
         return table | {"value": 1.0, "field": name}
-
-    def _corners_of(self, node: int) -> np.ndarray:
-        """The given (corner) nodes a new node lies between: an edge's two, a centre's four."""
-        e, position = np.argwhere(self.conn == node)[0]
-        if position == 8:
-            return self.conn[e, :4]
-        return self.conn[e, [position - 4, (position - 3) % 4]]
 
     def _cload(self, k: Keyword) -> list[dict]:
         vectors: dict[str, np.ndarray] = defaultdict(lambda: np.zeros(6))
@@ -582,7 +487,7 @@ class _Builder:
         # a concentrated load acts on the nodes the file names, not on the new ones between them
         wanted = f"{tokens[0]}_loaded" if len(groups) == 1 and len(set(tokens)) == 1 else f"cload_{k.where.split(':')[-1]}"
         for vector, labels in groups.items():
-            name = self.new_node_set(k, labels, wanted, lift=False)
+            name = self.shells.new_node_set(labels, wanted, k.label(), lift=False)
             for kind, part in (("point_force", vector[:3]), ("point_moment", vector[3:])):
                 if any(part):
                     loads.append({"type": kind, "set": name, "value": list(part)} | self._curve(k))
@@ -616,10 +521,10 @@ class _Builder:
     def _elements_set(self, k: Keyword, token: str) -> str:
         if qualified("", token) is None:
             key = self.model.key_of(self.model.elsets, token, "", k, "element set")
-            if ("elset", key) in self.set_of:
-                return self.set_of[("elset", key)]
-        elements = self._elements(self.model.element_labels(token, "", k))
-        return self._name(None, f"load_{k.where.split(':')[-1]}", self._surface_set(elements))
+            if ("elset", key) in self.shells.set_of:
+                return self.shells.set_of[("elset", key)]
+        elements = self.shells.elements_of(self.model.element_labels(token, "", k))
+        return self.shells.add_set(None, f"load_{k.where.split(':')[-1]}", self.shells.surface_set(elements))
 
     def _pressure(self, k: Keyword, token: str, magnitude: float) -> list[dict]:
         """Pressure loads on the mid-surface: the elements whose director is Abaqus' positive
@@ -629,7 +534,7 @@ class _Builder:
             if surface.kind == "node":
                 self.model.unmapped.append(f"{k.label()}: pressure on the node-based surface '{token}' is not read")
                 return []
-            faces = [(piece, side) for label, side in surface.items for piece in self.pieces_of.get(label, [])]
+            faces = [(piece, side) for label, side in surface.items for piece in self.shells.pieces_of.get(label, [])]
             if any(side not in ("SPOS", "SNEG") for _, side in faces):
                 self.model.unmapped.append(f"{k.label()}: surface '{token}' has faces that are neither SPOS nor SNEG; "
                                            "read as SPOS")
@@ -637,20 +542,20 @@ class _Builder:
             elements = np.asarray([e for e, _ in faces], dtype=np.int64)
             whole = ("surface", self.model.key_of(self.model.surfaces, token, "", k, "surface"))
         else:
-            elements = self._elements(self.model.element_labels(token, "", k))
+            elements = self.shells.elements_of(self.model.element_labels(token, "", k))
             sign = -np.ones(len(elements))
             whole = ("elset", self.model.key_of(self.model.elsets, token, "", k, "element set")) \
                 if qualified("", token) is None else None
-        sign = sign * self.side[elements]
+        sign = sign * self.shells.side[elements]
         loads = []
         for s in (-1.0, 1.0):
             chosen = np.unique(elements[sign == s])
             if not len(chosen):
                 continue
-            if whole in self.set_of and np.array_equal(self.sets[self.set_of[whole]].elements, chosen):
-                name = self.set_of[whole]
+            if whole in self.shells.set_of and np.array_equal(self.shells.sets[self.shells.set_of[whole]].elements, chosen):
+                name = self.shells.set_of[whole]
             else:
-                name = self._name(None, f"pressure_{k.where.split(':')[-1]}", self._surface_set(chosen))
+                name = self.shells.add_set(None, f"pressure_{k.where.split(':')[-1]}", self.shells.surface_set(chosen))
             loads.append({"type": "pressure", "set": name, "value": s * magnitude, "face": "mid"} | self._curve(k))
         return loads
 
@@ -674,7 +579,7 @@ class _Builder:
             else:
                 continue
             for row in pairs:
-                names = [n if n.lower() == "all" else self.set_of.get(("surface", m.key_of(m.surfaces, n, "", k, "surface")))
+                names = [n if n.lower() == "all" else self.shells.set_of.get(("surface", m.key_of(m.surfaces, n, "", k, "surface")))
                          for n in (row + row[:1])[:2]]
                 if None in names:
                     m.unmapped.append(f"{k.label()}: a contact of node-based surfaces is not read")
@@ -725,12 +630,6 @@ class _Builder:
                 m.unmapped.append(f"{k.label()}: implicit dynamics: shellsim integrates the step explicitly")
             solver = {"method": "explicit", "end_time": row[1] or 1.0}
         self.tables["solver"] = solver
-
-
-def _listed(labels: list[str]) -> str:
-    """Labels for a message: 'strip-1.3, strip-1.4 and 12 more'."""
-    shown = ", ".join(labels[:SHOWN_IDS])
-    return shown + (f" and {len(labels) - SHOWN_IDS} more" if len(labels) > SHOWN_IDS else "")
 
 
 def _is_number(text: str) -> bool:

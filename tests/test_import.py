@@ -292,3 +292,137 @@ def test_shellsim_import_writes_a_deck_that_checks(strip, tmp_path):
     before = (out / "deck.toml").read_text()
     again = runner.invoke(app, ["import", str(strip()), "--out", str(out)])
     assert again.exit_code == 2 and "exists" in again.output and (out / "deck.toml").read_text() == before
+
+
+def strip_feb(version: str = "4.0", pressure_facets: bool = False, reversed_elements: tuple = ()) -> str:
+    """The cantilever strip of :func:`strip_inp` as FEBio Studio saves it (format
+    ``version``): a quad4 shell domain of thickness 0.1 (3.0: as element data), the root
+    node set held (displacements and shell displacements), a nodal force on the tip nodes
+    ramped by a load curve, a static step of four steps; ``pressure_facets``: a surface
+    of those elements' facets (each element's nodes, reversed for ``reversed_elements``)
+    under pressure 2."""
+    nx, ny, four = 10, 2, version.startswith("4")
+    nodes = [(1 + i + j * (nx + 1), i * 1.0, j * 0.5) for j in range(ny + 1) for i in range(nx + 1)]
+    elements = {}
+    for j in range(ny):
+        for i in range(nx):
+            n1 = 1 + i + j * (nx + 1)
+            elements[1 + i + j * nx] = [n1, n1 + 1, n1 + nx + 2, n1 + nx + 1]
+
+    def id_set(tag: str, name: str, ids: list[int], child: str) -> str:
+        body = ",".join(map(str, ids)) if four else "".join(f'<{child} id="{i}"/>' for i in ids)
+        return f'<{tag} name="{name}">{body}</{tag}>'
+
+    root = [n for n, x, _ in nodes if x == 0.0]
+    tip = [n for n, x, _ in nodes if x == 10.0]
+    facets = "".join(f'<quad4 id="{k}">{",".join(map(str, elements[k][::-1] if k in reversed_elements else elements[k]))}'
+                     "</quad4>" for k in elements) if pressure_facets else ""
+    held = ("<x_dof>1</x_dof><y_dof>1</y_dof><z_dof>1</z_dof>" if four else "<dofs>x,y,z</dofs>")
+    force = ('<value lc="1">0,0,-0.001</value>' if four else '<dof>z</dof><scale lc="1">-0.001</scale>')
+    thickness = ('<shell_thickness>0.1</shell_thickness>' if four else "")
+    data = ("" if four else '<MeshData><ElementData var="shell thickness" elem_set="Strip">'
+            + "".join(f'<e lid="{k}">0.1,0.1,0.1,0.1</e>' for k in elements) + "</ElementData></MeshData>")
+    pressure = ('<surface_load type="pressure" surface="Top"><pressure lc="1">2.0</pressure></surface_load>'
+                if pressure_facets else "")
+    points = "<pt>0,0</pt><pt>1,1</pt>" if four else "<point>0,0</point><point>1,1</point>"
+    return f'''<?xml version="1.0" encoding="ISO-8859-1"?>
+<febio_spec version="{version}">
+  <Module type="solid"/>
+  <Control><analysis>STATIC</analysis><time_steps>4</time_steps><step_size>0.25</step_size></Control>
+  <Material><material id="1" name="Steel" type="isotropic elastic"><density>7.8e-9</density><E>200000</E><v>0</v></material></Material>
+  <Mesh>
+    <Nodes name="Object1">{"".join(f'<node id="{n}">{x},{y},0</node>' for n, x, y in nodes)}</Nodes>
+    <Elements type="quad4" name="Strip">{"".join(f'<elem id="{k}">{",".join(map(str, v))}</elem>' for k, v in elements.items())}</Elements>
+    {id_set("NodeSet", "Root", root, "n")}
+    {id_set("NodeSet", "Tip", tip, "n")}
+    <Surface name="Top">{facets}</Surface>
+  </Mesh>
+  <MeshDomains><ShellDomain name="Strip" mat="Steel">{thickness}</ShellDomain></MeshDomains>
+  {data}
+  <Boundary>
+    <bc name="Root" type="{'zero displacement' if four else 'fix'}" node_set="Root">{held}</bc>
+    <bc name="RootShell" type="zero shell displacement" node_set="Root"><sx_dof>1</sx_dof><sy_dof>1</sy_dof><sz_dof>1</sz_dof></bc>
+  </Boundary>
+  <Loads><nodal_load name="Tip" type="{'nodal_force' if four else 'nodal_load'}" node_set="Tip">{force}</nodal_load>{pressure}</Loads>
+  <LoadData><load_controller id="1" name="Ramp" type="loadcurve">
+    <interpolate>LINEAR</interpolate><points>{points}</points></load_controller></LoadData>
+  <Output><plotfile type="febio"><var type="displacement"/></plotfile></Output>
+</febio_spec>
+'''
+
+
+@pytest.mark.parametrize("version", ["4.0", "3.0"])
+def test_an_imported_febio_cantilever_bends_as_beam_theory_says(tmp_path, version):
+    """The strip from a FEBio file (both formats): clamped by its zero displacements and
+    shell displacements, the force on the three tip nodes, the load curve, the thickness
+    (from the domain, or the element data) and the static step come over, and the tip
+    deflection is P L^3 / (3 E I) within 0.5%."""
+    path = tmp_path / "strip.feb"
+    path.write_text(strip_feb(version))
+    done = import_model(path, tmp_path / "imported")
+    assert done.problems == [] and done.elements == 20
+    deck = load_deck(done.deck)
+    assert deck.boundary[0].type == "clamped" and deck.section.thickness == 0.1 and deck.solver.end_time == 1.0
+    done.deck.write_text(done.deck.read_text() + '''
+[[output.probe]]
+name = "tip"
+quantity = "displacement"
+set = "Tip"
+component = "z"
+''')
+    run = run_deck(load_deck(done.deck), done.deck.parent)
+    exact = -3e-3 * 10.0**3 / (3 * 2e5 * 0.1**3 / 12)
+    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+    assert any(re.search(r"output requests \(<Output> \(strip\.feb:\d+\)\)", line) for line in done.unmapped)
+
+
+def test_febio_pressure_pushes_against_each_facet_s_normal(tmp_path):
+    """A pressure 2 on facets that follow their elements' nodes except element 3's (given
+    the other way round): FEBio pushes against each facet's normal, 19 facets' along -z
+    and one's along +z: the resultant along z is -2 (9.5 - 0.5)."""
+    path = tmp_path / "plate.feb"
+    path.write_text(strip_feb(pressure_facets=True, reversed_elements=(3,)).replace('<value lc="1">0,0,-0.001</value>',
+                                                                                     '<value lc="1">0,0,0</value>'))
+    model = read_foreign(path)
+    tables = model.tables | {"geometry": {"builder": "file", "path": str(path)}, "solver": {"end_time": 1.0}}
+    tables["load"] = [t for t in tables["load"] if t["type"] == "pressure"]
+    assert len(tables["load"]) == 2
+    deck = parse_deck(deck_text(tables))
+    f, _ = initial_external_forces(build_model(deck, build_mesh(deck)), t=1.0)  # the curve's end: factor 1
+    assert f[:, 2].sum() == pytest.approx(-2.0 * (9.5 - 0.5), rel=1e-9)
+
+
+def test_febio_hgo_and_per_element_material_axes(tmp_path):
+    """FEBio's Holzapfel-Gasser-Ogden (c, k1, k2, kappa, gamma) as hgo with mu = c and the
+    families at +-gamma, material axis 1 per element from the mesh data's mat_axis."""
+    text = strip_feb().replace(
+        '<material id="1" name="Steel" type="isotropic elastic"><density>7.8e-9</density><E>200000</E><v>0</v></material>',
+        '<material id="1" name="Media" type="Holzapfel-Gasser-Ogden"><density>1.2e-9</density><c>0.0035</c>'
+        '<k1>2.3632</k1><k2>0.8393</k2><kappa>0.226</kappa><gamma>40</gamma><k>100</k></material>').replace(
+        'mat="Steel"', 'mat="Media"')
+    axes = "".join(f'<e lid="{k}"><a>{"0,1,0" if k == 7 else "1,0,0"}</a><d>0,0,1</d></e>' for k in range(1, 21))
+    text = text.replace("<Boundary>", f'<MeshData><ElementData type="mat_axis" elem_set="Strip">{axes}</ElementData>'
+                                      "</MeshData>\n  <Boundary>")
+    path = tmp_path / "hgo.feb"
+    path.write_text(text)
+    model = read_foreign(path)
+    assert model.tables["material"] == {"model": "hgo", "mu": 0.0035, "k1": 2.3632, "k2": 0.8393, "kappa": 0.226,
+                                         "beta_deg": 40.0, "axes": {"kind": "mesh", "field": "mat_axis"},
+                                         "density": 1.2e-9}
+    vectors = model.mesh.cell_vectors["mat_axis"]
+    assert np.allclose(vectors[model.mesh.sets["Strip"].elements[6]], [0, 1, 0])
+    assert np.allclose(np.delete(vectors, 6, axis=0), [1, 0, 0])
+
+
+@pytest.mark.parametrize("text, message", [
+    ("<febio_spec version='4.0'><Mesh>", r"not well-formed XML"),
+    ("<febio_spec version='2.5'/>", r"not a FEBio model of format 3\.0 or 4\.0 .*version '2\.5'"),
+    ("<febio_spec version='4.0'><Mesh><Nodes><node id='1'>0,x,0</node></Nodes></Mesh></febio_spec>",
+     r"<node> \(bad\.feb:1\): a node is 'x,y,z'"),
+    ("<febio_spec version='4.0'><Mesh/></febio_spec>", r"no shell elements in a <ShellDomain>"),
+])
+def test_a_broken_febio_file_is_refused_naming_its_line(tmp_path, text, message):
+    path = tmp_path / "bad.feb"
+    path.write_text(text)
+    with pytest.raises(MeshError, match=message):
+        read_foreign(path)

@@ -55,5 +55,11 @@ def _abaqus(path: Path) -> ForeignModel:
     return read_abaqus(path)
 
 
+def _febio(path: Path) -> ForeignModel:
+    from .febio import read_febio
+
+    return read_febio(path)
+
+
 #: File suffix -> the reader of that program's models.
-READERS = {".inp": _abaqus}
+READERS = {".inp": _abaqus, ".feb": _febio}

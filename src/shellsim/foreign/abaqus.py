@@ -24,6 +24,7 @@ from ..errors import MeshError
 from ..geometry.importing import ImportedMesh
 from . import ForeignModel
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
+from .deck_tables import AXES, pressure_loads, support_table
 from .shell_mesh import ShellMesh, deck_name, listed
 
 #: Abaqus shell types by their number of nodes.
@@ -39,7 +40,6 @@ NOT_SHELLS = {
 #: Abaqus' named boundary types: the degrees of freedom they fix.
 BOUNDARY_TYPES = {"encastre": {1, 2, 3, 4, 5, 6}, "pinned": {1, 2, 3}, "xsymm": {1, 5, 6}, "ysymm": {2, 4, 6},
                   "zsymm": {3, 4, 5}, "xasymm": {2, 3, 4}, "yasymm": {1, 3, 5}, "zasymm": {1, 2, 6}}
-AXES = "xyz"
 
 
 def read_abaqus(path: Path) -> ForeignModel:
@@ -427,26 +427,10 @@ class _Builder:
                     entry["values"][label] = value
 
     def _support(self, k: Keyword, tokens: list[str], dofs: set[int]) -> dict | None:
-        translations = sorted(d for d in dofs if d <= 3)
-        rotations = {d for d in dofs if d > 3}
         name = self.node_set_for(k, tokens, f"support_{tokens[0]}")
-        if len(translations) == 3 and len(rotations) == 3:
-            return {"type": "clamped", "set": name}
-        for axis in range(3):  # XSYMM and its kin: one translation and the two rotations that tilt the plane
-            if translations == [axis + 1] and rotations == {4, 5, 6} - {axis + 4}:
-                return {"type": "symmetry", "set": name, "normal": [float(axis == i) for i in range(3)]}
-        entry: dict = {"type": "fixed", "set": name, "translations": [AXES[d - 1] for d in translations]}
-        if len(rotations) == 3:
-            entry["director"] = "fixed"
-        elif len(rotations) == 2:  # free only about one axis: the director turns in the plane normal to it
-            free = ({4, 5, 6} - rotations).pop() - 4
-            entry["director_plane_normal"] = [float(free == i) for i in range(3)]
-        elif len(rotations) == 1:
-            self.model.unmapped.append(f"{k.label()}: on '{tokens[0]}' the rotation about {AXES[min(rotations) - 4]} "
-                                       "alone is held; a director has no such single rotation: left free (state the "
-                                       "support with director_plane_normal in the deck)")
-        if not translations and "director" not in entry and "director_plane_normal" not in entry:
-            return None
+        entry, problem = support_table(name, {d for d in dofs if d <= 3}, {d for d in dofs if d > 3})
+        if problem:
+            self.model.unmapped.append(f"{k.label()}: {problem}")
         return entry
 
     def _prescribed(self, dof: int, entry: dict) -> dict:
@@ -527,8 +511,8 @@ class _Builder:
         return self.shells.add_set(None, f"load_{k.where.split(':')[-1]}", self.shells.surface_set(elements))
 
     def _pressure(self, k: Keyword, token: str, magnitude: float) -> list[dict]:
-        """Pressure loads on the mid-surface: the elements whose director is Abaqus' positive
-        normal and the others, each with the sign that pushes where Abaqus pushes."""
+        """Pressure loads on the mid-surface pushing where Abaqus pushes: against a face's
+        outward normal (SPOS: the element's normal; SNEG: its opposite)."""
         if k.name == "dsload":
             surface = self.model.surface(token, k)
             if surface.kind == "node":
@@ -546,18 +530,8 @@ class _Builder:
             sign = -np.ones(len(elements))
             whole = ("elset", self.model.key_of(self.model.elsets, token, "", k, "element set")) \
                 if qualified("", token) is None else None
-        sign = sign * self.shells.side[elements]
-        loads = []
-        for s in (-1.0, 1.0):
-            chosen = np.unique(elements[sign == s])
-            if not len(chosen):
-                continue
-            if whole in self.shells.set_of and np.array_equal(self.shells.sets[self.shells.set_of[whole]].elements, chosen):
-                name = self.shells.set_of[whole]
-            else:
-                name = self.shells.add_set(None, f"pressure_{k.where.split(':')[-1]}", self.shells.surface_set(chosen))
-            loads.append({"type": "pressure", "set": name, "value": s * magnitude, "face": "mid"} | self._curve(k))
-        return loads
+        return pressure_loads(self.shells, elements, sign, magnitude, whole, f"pressure_{k.where.split(':')[-1]}",
+                              self._curve(k))
 
     # -- contact and solver -----------------------------------------------------------------
     def contact(self) -> None:

@@ -240,6 +240,9 @@ class MeshFile(Section):
     relative to the deck. Named sets come from the file's cell sets (gmsh physical groups)
     or from point-data arrays named ``set_<name>``.
 
+    An Abaqus input file (.inp) or a FEBio model (.feb) gives its shells, made 9-node
+    quads, and their sets (``shellsim import`` writes the rest of its scene as a deck).
+
     A triangulated surface (.stl, .obj, .ply, .vtp, .off) is remeshed with gmsh into quads
     of about ``element_size``; its open boundary loops become edge sets, each of
     ``boundaries`` naming the loop nearest its point (e.g. ``inlet = [0.0, 0.0, 0.0]``), the

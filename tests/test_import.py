@@ -15,7 +15,7 @@ from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import MeshError
 from shellsim.foreign import read_foreign
 from shellsim.foreign.quad_upgrade import split, upgrade
-from shellsim.foreign.writing import deck_text, import_model
+from shellsim.imported_deck import deck_text, import_model
 from shellsim.geometry import build_mesh
 from shellsim.geometry.importing import read_mesh
 from shellsim.model import build_model

@@ -21,11 +21,11 @@ FLOORS = [
     {"mesh"},
     {"loads"},
     {"deck"},
-    {"geometry"},
+    {"geometry", "foreign"},
     {"model", "plan"},
     {"solver"},
     {"output", "verify"},
-    {"execute", "study", "bench"},
+    {"execute", "study", "bench", "imported_deck"},
     {"cli", "__main__"},
 ]
 FLOOR = {part: level for level, parts in enumerate(FLOORS) for part in parts}

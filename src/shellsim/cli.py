@@ -168,7 +168,7 @@ def import_model(
     shells as 9-node quads with their sets and material axes, and the material, section,
     supports, loads, contact, amplitudes and first step as deck tables. What has no
     counterpart is listed (and written at the top of the deck), never dropped silently."""
-    from .foreign.writing import import_model as bring_over
+    from .imported_deck import import_model as bring_over
 
     folder = output_folder(out_dir or Path(model.stem))
     with err.status(f"reading {model}"):

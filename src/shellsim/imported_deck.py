@@ -9,10 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DeckError, OutputError, ShellsimError
-from ..mesh import Mesh
-from ..output.folder import output_folder, write_atomically
-from . import read_foreign
+from .errors import DeckError, OutputError, ShellsimError
+from .foreign import read_foreign
+from .mesh import Mesh
+from .output.folder import output_folder, write_atomically
 
 DECK_NAME = "deck.toml"
 #: The deck's tables in the order a reader expects them.
@@ -39,7 +39,7 @@ def import_model(source: Path, folder: Path) -> Imported:
     that cannot be read. The deck is validated and its sets checked against the mesh; its
     problems are returned, not raised: the deck is there to be edited.
     """
-    from ..output.mesh_files import write_mesh_vtu
+    from .output.mesh_files import write_mesh_vtu
 
     deck_path, mesh_path = folder / DECK_NAME, folder / f"{source.stem}.vtu"
     if deck_path.exists():
@@ -100,8 +100,8 @@ def _header(source: Path, unmapped: list[str]) -> str:
 
 def _problems(deck_path: Path) -> list[str]:
     """What ``shellsim check`` would refuse in the written deck (its sets read from the mesh)."""
-    from ..deck import load_deck
-    from ..geometry import build_mesh
+    from .deck import load_deck
+    from .geometry import build_mesh
 
     try:
         deck = load_deck(deck_path)

@@ -65,6 +65,25 @@ def strip_inp(tip_force: float = -1e-3, extra_model: str = "", extra_step: str =
     return "\n".join(line for line in lines if line) + "\n"
 
 
+#: The strip's tip deflection under its three tip forces of 1e-3: P L^3 / (3 E I) (shear
+#: adds P L / (k G A), 6e-5 of it), 0.6% of L: small enough to stay linear.
+BEAM_TIP = -3e-3 * 10.0**3 / (3 * 2e5 * 1.0 * 0.1**3 / 12)
+
+
+def tip_deflection(done, tip: str) -> float:
+    """The final z displacement of the set ``tip`` of an imported strip solved as its deck says."""
+    done.deck.write_text(done.deck.read_text() + f'''
+[[output.probe]]
+name = "tip"
+quantity = "displacement"
+set = "{tip}"
+component = "z"
+''')
+    run = run_deck(load_deck(done.deck), done.deck.parent)
+    assert run.status == "completed"
+    return float(np.asarray(run.history["tip"])[-1])
+
+
 @pytest.fixture
 def strip(tmp_path):
     def write(**options):
@@ -76,23 +95,10 @@ def strip(tmp_path):
 
 def test_an_imported_cantilever_bends_as_beam_theory_says(strip, tmp_path):
     """The strip (L = 10, b = 1, t = 0.1, E = 2e5, nu = 0) brought over and solved
-    statically: its tip deflection under the three tip forces is P L^3 / (3 E I) (shear
-    adds PL/(kGA), 6e-5 of it) within 0.5%, small enough (0.6% of L) to stay linear."""
+    statically: its tip deflection under the three tip forces is BEAM_TIP within 0.5%."""
     done = import_model(strip(), tmp_path / "imported")
     assert done.problems == []
-    text = done.deck.read_text() + '''
-[[output.probe]]
-name = "tip"
-quantity = "displacement"
-set = "Strip-1_Tip"
-component = "z"
-'''
-    done.deck.write_text(text)
-    run = run_deck(load_deck(done.deck), done.deck.parent)
-    assert run.status == "completed"
-    total, inertia = 3 * 1e-3, 1.0 * 0.1**3 / 12
-    exact = -total * 10.0**3 / (3 * 2e5 * inertia)
-    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+    assert tip_deflection(done, "Strip-1_Tip") == pytest.approx(BEAM_TIP, rel=5e-3)
 
 
 def test_triangles_split_into_quads_still_bend_as_beam_theory_says(tmp_path):
@@ -105,16 +111,7 @@ def test_triangles_split_into_quads_still_bend_as_beam_theory_says(tmp_path):
     assert done.problems == [] and done.elements == 20 * 3 + 10 * 4
     assert any(re.search(r"20 triangle\(s\) \(first at strip\.inp:\d+\): each split into three quads", line)
                for line in done.unmapped)
-    done.deck.write_text(done.deck.read_text() + '''
-[[output.probe]]
-name = "tip"
-quantity = "displacement"
-set = "Strip-1_Tip"
-component = "z"
-''')
-    run = run_deck(load_deck(done.deck), done.deck.parent)
-    exact = -3e-3 * 10.0**3 / (3 * 2e5 * 0.1**3 / 12)
-    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+    assert tip_deflection(done, "Strip-1_Tip") == pytest.approx(BEAM_TIP, rel=5e-3)
 
 
 def test_the_strip_s_deck_says_what_the_file_says(strip, tmp_path):
@@ -206,21 +203,6 @@ def test_what_cannot_come_over_is_listed_with_its_line_and_a_mesh_deck_refuses_i
         assert line in done.deck.read_text()
     with pytest.raises(MeshError, match=r"T3D2.*strip\.inp:\d+"):
         read_mesh(path)
-
-
-@pytest.mark.parametrize("text, message", [
-    ("1, 0., 0., 0.\n*Node\n", r"data before the first keyword"),
-    ("*Node\n1, 0., 0.\n*Element, type=S4\n1, 1, 2, 3, 4\n", r"nodes that are not defined: 2"),
-    ("*Node\n1, a, 0., 0.\n", r"bad\.inp:2.*label, x, y, z"),
-    ("*Nset, nset=A\nNowhere\n", r"\*NSET \(bad\.inp:1\): unknown node set 'Nowhere'"),
-    ("*Include, input=missing.inp\n", r"missing\.inp' cannot be read"),
-    ("*Node\n1, 0., 0., 0.\n", r"no shell elements shellsim reads"),
-])
-def test_a_broken_input_file_is_refused_naming_its_line(tmp_path, text, message):
-    path = tmp_path / "bad.inp"
-    path.write_text(text)
-    with pytest.raises(MeshError, match=message):
-        read_foreign(path)
 
 
 def test_included_files_per_node_motion_and_symmetry(strip, tmp_path):
@@ -363,16 +345,7 @@ def test_an_imported_febio_cantilever_bends_as_beam_theory_says(tmp_path, versio
     assert done.problems == [] and done.elements == 20
     deck = load_deck(done.deck)
     assert deck.boundary[0].type == "clamped" and deck.section.thickness == 0.1 and deck.solver.end_time == 1.0
-    done.deck.write_text(done.deck.read_text() + '''
-[[output.probe]]
-name = "tip"
-quantity = "displacement"
-set = "Tip"
-component = "z"
-''')
-    run = run_deck(load_deck(done.deck), done.deck.parent)
-    exact = -3e-3 * 10.0**3 / (3 * 2e5 * 0.1**3 / 12)
-    assert np.asarray(run.history["tip"])[-1] == pytest.approx(exact, rel=5e-3)
+    assert tip_deflection(done, "Tip") == pytest.approx(BEAM_TIP, rel=5e-3)
     assert any(re.search(r"output requests \(<Output> \(strip\.feb:\d+\)\)", line) for line in done.unmapped)
 
 
@@ -414,15 +387,22 @@ def test_febio_hgo_and_per_element_material_axes(tmp_path):
     assert np.allclose(np.delete(vectors, 6, axis=0), [1, 0, 0])
 
 
-@pytest.mark.parametrize("text, message", [
-    ("<febio_spec version='4.0'><Mesh>", r"not well-formed XML"),
-    ("<febio_spec version='2.5'/>", r"not a FEBio model of format 3\.0 or 4\.0 .*version '2\.5'"),
-    ("<febio_spec version='4.0'><Mesh><Nodes><node id='1'>0,x,0</node></Nodes></Mesh></febio_spec>",
+@pytest.mark.parametrize("name, text, message", [
+    ("bad.inp", "1, 0., 0., 0.\n*Node\n", r"data before the first keyword"),
+    ("bad.inp", "*Node\n1, 0., 0.\n*Element, type=S4\n1, 1, 2, 3, 4\n", r"nodes that are not defined: 2"),
+    ("bad.inp", "*Node\n1, a, 0., 0.\n", r"bad\.inp:2.*label, x, y, z"),
+    ("bad.inp", "*Nset, nset=A\nNowhere\n", r"\*NSET \(bad\.inp:1\): unknown node set 'Nowhere'"),
+    ("bad.inp", "*Include, input=missing.inp\n", r"missing\.inp' cannot be read"),
+    ("bad.inp", "*Node\n1, 0., 0., 0.\n", r"no shell elements shellsim reads"),
+    ("bad.feb", "<febio_spec version='4.0'><Mesh>", r"not well-formed XML"),
+    ("bad.feb", "<febio_spec version='2.5'/>", r"not a FEBio model of format 3\.0 or 4\.0 .*version '2\.5'"),
+    ("bad.feb", "<febio_spec version='4.0'><Mesh><Nodes><node id='1'>0,x,0</node></Nodes></Mesh></febio_spec>",
      r"<node> \(bad\.feb:1\): a node is 'x,y,z'"),
-    ("<febio_spec version='4.0'><Mesh/></febio_spec>", r"no shell elements in a <ShellDomain>"),
+    ("bad.feb", "<febio_spec version='4.0'><Mesh/></febio_spec>", r"no shell elements in a <ShellDomain>"),
+    ("bad.stl", "solid", r"not a model file shellsim reads \(suffixes: \.feb, \.inp\)"),
 ])
-def test_a_broken_febio_file_is_refused_naming_its_line(tmp_path, text, message):
-    path = tmp_path / "bad.feb"
+def test_a_broken_model_file_is_refused_naming_its_line(tmp_path, name, text, message):
+    path = tmp_path / name
     path.write_text(text)
     with pytest.raises(MeshError, match=message):
         read_foreign(path)

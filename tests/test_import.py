@@ -33,7 +33,7 @@ def strip_inp(tip_force: float = -1e-3, extra_model: str = "", extra_step: str =
     the first ``triangles`` cut into two S3R triangles each."""
     length, width = 10.0, 1.0
     nodes = [(1 + i + j * (nx + 1), i * length / nx, j * width / ny) for j in range(ny + 1) for i in range(nx + 1)]
-    lines = ["*Heading", " Cantilever strip, S4R, tip load", "** a comment", "*Part, name=Strip", "*Node"]
+    lines = ["*Heading", " Cantilever strip, S4R, tip load", "** a comment", '*Part, name="Strip"', "*Node"]
     lines += [f"{n}, {x!r}, {y!r}, 0." for n, x, y in nodes]
     quads, cut = ["*Element, type=S4R"], ["*Element, type=S3R"]
     for j in range(ny):

@@ -101,5 +101,5 @@ def _keyword(line: str, where: str) -> Keyword:
         if not part:
             continue
         key, _, value = part.partition("=")
-        params[" ".join(key.lower().split())] = value.strip()
+        params[" ".join(key.lower().split())] = value.strip().strip('"')  # a name with spaces is quoted
     return Keyword(name, params, where)

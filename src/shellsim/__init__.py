@@ -13,17 +13,22 @@ except PackageNotFoundError:  # running from a source tree that is not installed
 
 
 def _numba_cache_dir() -> str:
-    """A compiled-code cache folder keyed by the package's source.
+    """A compiled-code cache folder keyed by the package's source and LLVM's optimisation
+    level.
 
     numba checks a cached function against its own file only, so after a change to
     element/response.py the time loop in solver/explicit.py would keep running the old
     element code compiled into it. One folder per version of the whole source avoids that.
     """
-    digest = hashlib.sha1()
+    digest = hashlib.sha1(os.environ["NUMBA_OPT"].encode())
     for path in sorted(Path(__file__).parent.rglob("*.py")):
         digest.update(path.read_bytes())
     base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
     return str(base / "shellsim" / "numba" / digest.hexdigest()[:16])
 
 
+# LLVM's level 1 compiles the kernels a fifth faster than numba's default 3 and runs them as
+# fast, to the same bits (no fast-math is used; docs/verification.md, "Optimisation level").
+# Read by numba when it is first imported: after shellsim, as here.
+os.environ.setdefault("NUMBA_OPT", "1")
 os.environ.setdefault("NUMBA_CACHE_DIR", _numba_cache_dir())

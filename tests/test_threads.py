@@ -57,3 +57,16 @@ def test_one_and_two_threads_give_identical_bits(tmp_path):
     for a, b in zip(one, two):
         assert np.abs(a).max() > 0.0
         np.testing.assert_array_equal(a, b)
+
+
+def test_kernels_compile_at_llvm_level_1_unless_told_and_each_level_has_its_own_cache():
+    """shellsim sets numba's optimisation level to 1 (docs/verification.md: a fifth less
+    compiling, the same speed and bits); a level the user sets wins, and the compiled-code
+    cache folder differs by level, so no level loads another's code."""
+    probe = "import shellsim, numba, os; print(int(numba.config.OPT), os.environ['NUMBA_CACHE_DIR'])"
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_OPT", "NUMBA_CACHE_DIR")}
+    default = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, check=True)
+    told = subprocess.run([sys.executable, "-c", probe], env=env | {"NUMBA_OPT": "3"}, capture_output=True, text=True,
+                          check=True)
+    (level, folder), (told_level, told_folder) = default.stdout.split(), told.stdout.split()
+    assert (level, told_level) == ("1", "3") and folder != told_folder

@@ -4,6 +4,7 @@ closed forms (a cantilever's tip deflection, a cylinder's radius, pressure resul
 
 from __future__ import annotations
 
+import os
 import re
 
 import numpy as np
@@ -366,24 +367,30 @@ def test_febio_pressure_pushes_against_each_facet_s_normal(tmp_path):
     assert f[:, 2].sum() == pytest.approx(-2.0 * (9.5 - 0.5), rel=1e-9)
 
 
-def test_febio_hgo_and_per_element_material_axes(tmp_path):
+@pytest.mark.parametrize("kind", ["mat_axis", "fiber"])
+def test_febio_hgo_and_per_element_material_axes(tmp_path, kind):
     """FEBio's Holzapfel-Gasser-Ogden (c, k1, k2, kappa, gamma) as hgo with mu = c and the
-    families at +-gamma, material axis 1 per element from the mesh data's mat_axis."""
+    families at +-gamma, material axis 1 per element from the mesh data's mat_axis (its a
+    vector; format 4.0) or fiber (format 3.0)."""
     text = strip_feb().replace(
         '<material id="1" name="Steel" type="isotropic elastic"><density>7.8e-9</density><E>200000</E><v>0</v></material>',
         '<material id="1" name="Media" type="Holzapfel-Gasser-Ogden"><density>1.2e-9</density><c>0.0035</c>'
         '<k1>2.3632</k1><k2>0.8393</k2><kappa>0.226</kappa><gamma>40</gamma><k>100</k></material>').replace(
         'mat="Steel"', 'mat="Media"')
-    axes = "".join(f'<e lid="{k}"><a>{"0,1,0" if k == 7 else "1,0,0"}</a><d>0,0,1</d></e>' for k in range(1, 21))
-    text = text.replace("<Boundary>", f'<MeshData><ElementData type="mat_axis" elem_set="Strip">{axes}</ElementData>'
-                                      "</MeshData>\n  <Boundary>")
+    axis = {k: "0,1,0" if k == 7 else "1,0,0" for k in range(1, 21)}
+    if kind == "mat_axis":
+        data = '<ElementData type="mat_axis" elem_set="Strip">' + "".join(
+            f'<e lid="{k}"><a>{a}</a><d>0,0,1</d></e>' for k, a in axis.items())
+    else:
+        data = '<ElementData var="fiber" elem_set="Strip">' + "".join(f'<e lid="{k}">{a}</e>' for k, a in axis.items())
+    text = text.replace("<Boundary>", f"<MeshData>{data}</ElementData></MeshData>\n  <Boundary>")
     path = tmp_path / "hgo.feb"
     path.write_text(text)
     model = read_foreign(path)
     assert model.tables["material"] == {"model": "hgo", "mu": 0.0035, "k1": 2.3632, "k2": 0.8393, "kappa": 0.226,
-                                         "beta_deg": 40.0, "axes": {"kind": "mesh", "field": "mat_axis"},
+                                         "beta_deg": 40.0, "axes": {"kind": "mesh", "field": kind},
                                          "density": 1.2e-9}
-    vectors = model.mesh.cell_vectors["mat_axis"]
+    vectors = model.mesh.cell_vectors[kind]
     assert np.allclose(vectors[model.mesh.sets["Strip"].elements[6]], [0, 1, 0])
     assert np.allclose(np.delete(vectors, 6, axis=0), [1, 0, 0])
 
@@ -393,7 +400,7 @@ def test_febio_hgo_and_per_element_material_axes(tmp_path):
     ("bad.inp", "*Node\n1, 0., 0.\n*Element, type=S4\n1, 1, 2, 3, 4\n", r"nodes that are not defined: 2"),
     ("bad.inp", "*Node\n1, a, 0., 0.\n", r"bad\.inp:2.*label, x, y, z"),
     ("bad.inp", "*Nset, nset=A\nNowhere\n", r"\*NSET \(bad\.inp:1\): unknown node set 'Nowhere'"),
-    ("bad.inp", "*Include, input=missing.inp\n", r"missing\.inp' cannot be read"),
+    ("bad.inp", "*Include, input=missing.inp\n", r"\*INCLUDE \(bad\.inp:1\): model file '.*missing\.inp' not found"),
     ("bad.inp", "*Node\n1, 0., 0., 0.\n", r"no shell elements shellsim reads"),
     ("bad.feb", "<febio_spec version='4.0'><Mesh>", r"not well-formed XML"),
     ("bad.feb", "<febio_spec version='2.5'/>", r"not a FEBio model of format 3\.0 or 4\.0 .*version '2\.5'"),
@@ -401,9 +408,24 @@ def test_febio_hgo_and_per_element_material_axes(tmp_path):
      r"<node> \(bad\.feb:1\): a node is 'x,y,z'"),
     ("bad.feb", "<febio_spec version='4.0'><Mesh/></febio_spec>", r"no shell elements in a <ShellDomain>"),
     ("bad.stl", "solid", r"not a model file shellsim reads \(suffixes: \.feb, \.inp\)"),
+    ("bad.inp", "*Nset, nset=A, generate\n1, 100000000000, 1\n", r"bad\.inp:2\): GENERATE from 1 to 100000000000 by 1 "
+                                                                  r"is not a range of at most 10,000,000 labels"),
+    ("bad.inp", "*Include, input=.\n", r"model file '.*' is not a regular file"),
 ])
 def test_a_broken_model_file_is_refused_naming_its_line(tmp_path, name, text, message):
     path = tmp_path / name
     path.write_text(text)
     with pytest.raises(MeshError, match=message):
         read_foreign(path)
+
+
+def test_a_pipe_named_as_a_model_is_refused_not_read(tmp_path):
+    """A FIFO would block the read for ever: it is named instead, as the model and as an
+    included file."""
+    pipe = tmp_path / "pipe.inp"
+    os.mkfifo(pipe)
+    with pytest.raises(MeshError, match=r"pipe\.inp' is not a regular file"):
+        read_foreign(pipe)
+    (tmp_path / "model.inp").write_text("*Include, input=pipe.inp\n")
+    with pytest.raises(MeshError, match=r"\*INCLUDE \(model\.inp:1\): .*pipe\.inp' is not a regular file"):
+        read_foreign(tmp_path / "model.inp")

@@ -37,7 +37,17 @@ def read_foreign(path: Path) -> ForeignModel:
     reader = READERS.get(Path(path).suffix.lower())
     if reader is None:
         raise MeshError(f"'{path}' is not a model file shellsim reads (suffixes: {', '.join(sorted(READERS))})")
+    check_model_file(Path(path))
     return reader(Path(path))
+
+
+def check_model_file(path: Path) -> None:
+    """MeshError unless ``path`` is a regular file: a folder, a missing file or a FIFO
+    (which would block the read for ever) is named instead of read."""
+    if not path.exists():
+        raise MeshError(f"model file '{path}' not found")
+    if not path.is_file():
+        raise MeshError(f"model file '{path}' is not a regular file (a folder, a pipe or a device?)")
 
 
 def read_foreign_mesh(path: Path) -> ImportedMesh:

@@ -13,6 +13,8 @@ import numpy as np
 from ..errors import MeshError
 from .inp_syntax import Keyword, read_keywords
 
+#: The most labels one GENERATE line may give (a typo in a range must not fill the memory).
+MAX_GENERATED = 10_000_000
 #: Keywords that belong to the *MATERIAL above them.
 MATERIAL_OPTIONS = {"density", "elastic", "hyperelastic", "anisotropic hyperelastic", "user material", "depvar",
                     "damping", "plastic", "viscoelastic", "expansion", "hysteresis", "mullins effect",
@@ -241,6 +243,9 @@ def _set(model: AbaqusModel, k: Keyword, prefix: str, named_as: str) -> None:
                 first, last, step = (int(v) for v in (row + ["1"])[:3])
             except ValueError:
                 raise MeshError(f"{k.at(line)}: GENERATE takes 'first, last, step'; got '{', '.join(row)}'") from None
+            if step < 1 or (last - first) // step + 1 > MAX_GENERATED:
+                raise MeshError(f"{k.at(line)}: GENERATE from {first} to {last} by {step} is not a range of at most "
+                                f"{MAX_GENERATED:,} labels")
             labels += [qualified(prefix, str(i)) for i in range(first, last + 1, step)]
     elif is_nodes and k.param("elset"):
         wanted = set(model.element_labels(k.param("elset"), prefix, k))

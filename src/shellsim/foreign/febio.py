@@ -251,17 +251,20 @@ class _Reader:
         self.tables["material"] = table | {"density": self.density if self.density is not None else 1.0}
 
     def _axes(self, material: ET.Element) -> dict:
-        """Material axis 1: per element from the mesh data's mat_axis, or the material's own."""
+        """Material axis 1: per element from the mesh data's mat_axis or fiber, or the
+        material's own."""
         for data in self.root.findall("MeshData/ElementData"):
-            if (data.get("type") or data.get("var")) == "mat_axis":
+            kind = data.get("type") or data.get("var")
+            if kind in ("mat_axis", "fiber"):  # axis 1 as a frame's a vector, or as the fibre itself
                 labels = self.element_sets.get(data.get("elem_set"), [])
                 vectors = np.full((len(self.shells.conn), 3), np.nan)
                 for e in data.findall("e"):
-                    vectors[self.shells.elements_of([labels[int(e.get("lid")) - 1]])] = _vector(e.findtext("a"))
+                    direction = e.findtext("a") if kind == "mat_axis" else e.text
+                    vectors[self.shells.elements_of([labels[int(e.get("lid")) - 1]])] = _vector(direction)
                 if np.isnan(vectors).any():
                     raise MeshError(f"{self.where(data)}: no axis for elements "
                                     f"{', '.join(self.shells.labels_of(np.isnan(vectors).any(axis=1))[:5])}")
-                field = deck_name(data.get("name") or "mat_axis", "axis")
+                field = deck_name(data.get("name") or kind, "axis")
                 self.shells.cell_vectors[field] = vectors
                 return {"kind": "mesh", "field": field}
         axis = material.find("mat_axis")

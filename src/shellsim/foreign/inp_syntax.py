@@ -51,6 +51,9 @@ def read_keywords(path: Path) -> list[Keyword]:
 
 
 def _read(path: Path, seen: tuple[Path, ...]) -> list[Keyword]:
+    from . import check_model_file
+
+    check_model_file(path)
     resolved = path.resolve()
     if resolved in seen:
         raise MeshError(f"input file '{path}' includes itself (through {' -> '.join(str(p) for p in seen)})")
@@ -71,7 +74,10 @@ def _read(path: Path, seen: tuple[Path, ...]) -> list[Keyword]:
                 included = keyword.param("input")
                 if not included:
                     raise MeshError(f"{keyword.label()}: INPUT= names no file")
-                keywords.extend(_read(path.parent / included.strip('"'), seen + (resolved,)))
+                try:
+                    keywords.extend(_read(path.parent / included.strip('"'), seen + (resolved,)))
+                except MeshError as error:
+                    raise MeshError(f"{keyword.label()}: {error}") from None
             else:
                 keywords.append(keyword)
             continue

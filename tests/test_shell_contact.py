@@ -277,6 +277,21 @@ def test_the_gap_between_two_plates_is_their_faces_clearance_within_the_search_s
     np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, initial_shape(model)), expected, rtol=0, atol=1e-12)
 
 
+def test_the_faces_keep_their_initial_thickness_as_the_shell_thins(tmp_path):
+    """The plates 0.003 apart, their fibre lengths halved (as a stretched incompressible
+    shell thins): the gaps stay 0.003. A contact whose thickness followed the fibre lengths
+    would store spring energy no force accounts for (the held valve's creep)."""
+    from shellsim.bundles import Shape
+    from shellsim.model import build_model
+
+    text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3, 0.003).as_posix()}"',
+                     '[[contact]]\ntype = "shells"\nname = "between"\nset = "upper"\nagainst = "lower"\n')
+    deck = parse_deck(text)
+    model = build_model(deck, build_mesh(deck))
+    thinned = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=0.5 * model.h0)
+    np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, thinned), 0.003, rtol=0, atol=1e-12)
+
+
 def test_the_contact_forces_are_the_derivative_of_the_energy_the_springs_hold(tmp_path):
     """Two plates built touching, then the upper one moved 0.002 into the lower: the
     energy the contact's springs hold (history column between_energy), differenced over

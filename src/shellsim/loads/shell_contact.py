@@ -5,7 +5,11 @@ another set, by penalty, node against face both ways (the search is
 The shell's faces are its mid-surface offset by half the fibre length on each side (the
 shell thickness offset of LS-DYNA's contacts): a node y of one side and the nearest point
 p of a face of the other are in contact when their distance is less than
-``offset`` (h_y + h_p) / 2, h the current fibre lengths (h_p interpolated on the face).
+``offset`` (h_y + h_p) / 2, h the initial fibre lengths (h_p interpolated on the face).
+The contact's thickness does not follow the shell's thinning (LS-DYNA's default,
+THKCHG = 0): a thickness that changed under a held contact would store or release spring
+energy that no force accounts for (a closed valve held under pressure crept, its balance
+error growing to 6% in 0.16 s; docs/verification.md).
 The gap g = |y - p| - offset (h_y + h_p) / 2 is then negative and the node is pushed
 out along n = (y - p) / |y - p| by F = -k g n, the face's nine nodes back by N_a(p) F
 (the face's shape functions where p is). Both sides are tested: each node of the set
@@ -34,6 +38,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from ..bundles import Shape
 from ..errors import MeshError
 from ..table_types import Name, Positive
 from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
@@ -188,6 +193,12 @@ def share_of(penalty: float) -> float:
     """The share of the critical step that stays stable with both passes' springs of scale
     ``penalty``: 1 / sqrt(1 + s / 2)."""
     return float(1.0 / np.sqrt(1.0 + penalty / 2.0))
+
+
+@njit(cache=True)
+def _at_initial_thickness(model, shape):
+    """``shape`` as the contact sees it: its faces at the initial fibre lengths."""
+    return Shape(shape.x, shape.d, shape.e1, model.body.h0)
 
 
 @njit(cache=True)
@@ -381,6 +392,7 @@ def _contact_chunk(first, stop, shape, loads, grid):
 @njit(cache=True)
 def add_forces(t, model, shape, loads, f, g):
     """f (n, 3) += the contact forces on the current ``shape`` (none on the directors, g)."""
+    shape = _at_initial_thickness(model, shape)
     if loads.nodes.shape[0] == 0:
         return
     _contact_forces(model, shape, loads)
@@ -440,6 +452,7 @@ def add_friction(t, model, shape, loads, f, g, v, w):
 @njit(cache=True)
 def item_forces(t, model, shape, loads, out):
     """out (K, 3): the force on each contact node (for the history)."""
+    shape = _at_initial_thickness(model, shape)
     _contact_forces(model, shape, loads)
     out[:] = loads.touch_forces[:, 0]
 
@@ -449,6 +462,7 @@ def deepest(t, model, shape, loads):
     """(item, share): the contact node deepest into the face it touches on the current
     ``shape``, by the share of the offset between them it has gone through (0: the faces
     touch; 1: the node on the face's mid-surface); (-1, 0.0) where none touches."""
+    shape = _at_initial_thickness(model, shape)
     best, share = -1, 0.0
     if loads.nodes.shape[0] == 0:
         return best, share
@@ -467,6 +481,7 @@ def item_energies(t, model, shape, loads, out):
     """out (K,): the energy stored in each contact node's spring on the current shape, its
     push integrated over the depth d: k (d + w)^3 / (12 w) within the smoothing width w,
     (2/3) k w^2 + k (d^2 - w^2) / 2 past it."""
+    shape = _at_initial_thickness(model, shape)
     if loads.nodes.shape[0] == 0:
         return
     _contact_forces(model, shape, loads)
@@ -505,6 +520,7 @@ def item_gaps(t, model, shape, loads, out):
     nearest face it may touch less the offset (:func:`_depth`'s depth, negated), +inf
     where none is within :data:`GAP_REACH` times the contact's reach (a clearance of
     about a thickness)."""
+    shape = _at_initial_thickness(model, shape)
     if loads.nodes.shape[0] == 0:
         return
     grid = _grid(shape, loads, GAP_REACH)
@@ -522,6 +538,7 @@ def farthest_moved(t, model, shape, loads, before):
     moved; (-1, 0.0) for none. A node passing through the face would have moved more
     than that distance: parts that move together (a strip's neighbouring elements
     rolling up) count nothing."""
+    shape = _at_initial_thickness(model, shape)
     best, share = -1, 0.0
     if loads.nodes.shape[0] == 0:
         return best, share
@@ -552,6 +569,7 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
     translations (central differences of step ``step_u``; the pair and the fibre lengths
     held): nodes (K, 10) the node numbers and blocks (K, 30, 30) dF/dx, filled from the
     top. Returns how many pairs touch."""
+    shape = _at_initial_thickness(model, shape)
     grid = _grid(shape, loads, 1.0)
     work = _work()
     plus, minus = np.empty((10, 3)), np.empty((10, 3))

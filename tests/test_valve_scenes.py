@@ -26,7 +26,7 @@ REFERENCES = [{"quantity": "orifice area", "probe": "orifice_area", "measure": m
 
 @pytest.fixture(scope="module")
 def closing(tmp_path_factory):
-    """(run, folder): the closing valve on 8 x 6 elements a leaflet (96 in all), with its
+    """(run, folder): the closing valve on 8 x 6 elements a leaflet (144 in all), with its
     renders."""
     from shellsim.cli import _deck_renders
     from shellsim.execute import run_scene

@@ -221,7 +221,10 @@ class _Reader:
         m = materials[used[0]]
         kind = m.get("type")
         value = {child.tag: child.text for child in m}
-        number = lambda key, default=None: float(value[key]) if key in value else default  # noqa: E731
+
+        def number(key: str, default: float | None = None) -> float | None:
+            return float(value[key]) if key in value else default
+
         self.density = number("density")
         table = None
         if kind == "neo-Hookean":

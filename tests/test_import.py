@@ -417,6 +417,13 @@ def test_a_broken_model_file_is_refused_naming_its_line(tmp_path, name, text, me
         read_foreign(path)
 
 
+def test_a_value_that_is_not_a_number_is_a_message_not_a_traceback(tmp_path):
+    path = tmp_path / "strip.inp"
+    path.write_text(strip_inp().replace("*Density\n7.8e-9", "*Density\nheavy"))
+    with pytest.raises(MeshError, match=r"strip\.inp' holds a value shellsim cannot read .*'heavy'"):
+        read_foreign(path)
+
+
 def test_a_pipe_named_as_a_model_is_refused_not_read(tmp_path):
     """A FIFO would block the read for ever: it is named instead, as the model and as an
     included file."""

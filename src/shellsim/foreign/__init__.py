@@ -38,7 +38,11 @@ def read_foreign(path: Path) -> ForeignModel:
     if reader is None:
         raise MeshError(f"'{path}' is not a model file shellsim reads (suffixes: {', '.join(sorted(READERS))})")
     check_model_file(Path(path))
-    return reader(Path(path))
+    try:
+        return reader(Path(path))
+    except (ValueError, IndexError) as error:  # a number that is not one, a data line cut short
+        raise MeshError(f"model file '{path}' holds a value shellsim cannot read ({error}): a number that is not a "
+                        "number, or a data line with fields missing") from None
 
 
 def check_model_file(path: Path) -> None:

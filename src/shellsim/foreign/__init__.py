@@ -32,6 +32,11 @@ class ForeignModel:
     unused_elements: list[str]
 
 
+def meta_table(path: Path, title: str) -> dict:
+    """The deck's ``[meta]`` of a model brought over from ``path``."""
+    return {"title": title, "description": f"Brought over from {path.name}", "source": path.name}
+
+
 def read_foreign(path: Path) -> ForeignModel:
     """The model in ``path``, read by the reader of its suffix; MeshError for another file."""
     reader = READERS.get(Path(path).suffix.lower())

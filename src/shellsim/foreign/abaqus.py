@@ -21,8 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MeshError
-from ..geometry.importing import ImportedMesh
-from . import ForeignModel
+from . import ForeignModel, meta_table
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
 from .deck_tables import AXES, pressure_loads, support_table
 from .shell_mesh import ShellMesh, deck_name, listed
@@ -52,9 +51,8 @@ def read_abaqus(path: Path) -> ForeignModel:
     builder.supports_and_loads()
     builder.contact()
     builder.solver()
-    tables = {"meta": {"title": model.heading or path.stem, "description": f"Brought over from {path.name}",
-                       "source": path.name}} | builder.tables
-    return ForeignModel(builder.imported(), tables, model.unmapped, builder.unused_elements)
+    tables = {"meta": meta_table(path, model.heading or path.stem)} | builder.tables
+    return ForeignModel(builder.shells.imported(), tables, model.unmapped, builder.unused_elements)
 
 
 class _Builder:
@@ -135,9 +133,6 @@ class _Builder:
                     return self.shells.set_of[(what, key)]
         return self.shells.new_node_set([label for token in dict.fromkeys(tokens)
                                          for label in self.model.node_labels(token, "", k)], wanted, k.label())
-
-    def imported(self) -> ImportedMesh:
-        return self.shells.imported()
 
     # -- material and section ---------------------------------------------------------------
     def material_and_section(self) -> None:

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MeshError
-from . import ForeignModel
+from . import ForeignModel, meta_table
 from .deck_tables import AXES, pressure_loads, support_table
 from .shell_mesh import ShellMesh, deck_name
 
@@ -67,8 +67,7 @@ class _Reader:
         self.path, self.root = path, root
         self.unmapped: list[str] = []
         self.unused_elements: list[str] = []
-        self.tables: dict = {"meta": {"title": path.stem, "description": f"Brought over from {path.name}",
-                                      "source": path.name}}
+        self.tables: dict = {"meta": meta_table(path, path.stem)}
         for section in root:
             if section.tag in QUIET:
                 continue
@@ -151,7 +150,8 @@ class _Reader:
             nodes = self.shells.nodes_of(labels)
             if len(nodes):
                 self.shells.add_set(("nset", name), name, self.shells.node_set(nodes))
-        self.faces = {s.get("name"): self._faces(s) for s in mesh.findall("Surface")}
+        by_corners = {frozenset(corners): i for i, corners in enumerate(self.corner_labels)}
+        self.faces = {s.get("name"): self._faces(s, by_corners) for s in mesh.findall("Surface")}
         for name, faces in self.faces.items():
             if faces:
                 self.shells.add_set(("surface", name), name, self.shells.surface_set(
@@ -161,10 +161,10 @@ class _Reader:
                       for p in mesh.findall("SurfacePair")}
         self._thickness()
 
-    def _faces(self, surface: ET.Element) -> list[tuple[int, float]]:
+    def _faces(self, surface: ET.Element, by_corners: dict) -> list[tuple[int, float]]:
         """The surface's facets as (mesh element, +1 where the facet's normal is the file
-        element's own, -1 where opposite); facets on no shell element are listed."""
-        by_corners = {frozenset(corners): i for i, corners in enumerate(self.corner_labels)}
+        element's own, -1 where opposite); facets on no shell element are listed.
+        ``by_corners``: each file element's index by its set of corner labels."""
         faces, lost = [], 0
         for facet in surface:
             nodes = [n.strip() for n in (facet.text or "").split(",")][:3 if facet.tag == "tri3" else 4]

@@ -480,7 +480,8 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
         row("source", scene.meta.source)
     row("geometry", f"{g.builder} ({params})")
     divisions = " x ".join(f"{v} {k}" for k, v in scene.mesh.divisions.items())
-    row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}), "
+    cables = f", {len(built.lines)} cable elements" if len(built.lines) else ""
+    row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}){cables}, "
                           f"{built.n_nodes} nodes, {5 * built.n_nodes} DOFs")
     m = scene.material
     params = ", ".join(f"{k}={v}" for k, v in m.model_dump().items() if k not in ("model", "axes"))
@@ -497,6 +498,8 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
         row("load", f"{load.type} {load.value}{curve} on '{load.set}'")
     for contact in scene.contact:
         row("contact", f"{contact.summary} ({len(built.sets[contact.set].nodes)} nodes)")
+    for cable in scene.cable:
+        row("cable", cable.summary)
     sv = scene.solver
     if sv.method == "static":
         st = sv.static

@@ -24,9 +24,9 @@ FACES = {"bottom": -1, "mid": 0, "top": 1}
 class NamedSet:
     """Nodes of a named set and, for edge and surface sets, the pieces they are made of.
 
-    kind : 'surface', 'edge' or 'point'.
+    kind : 'surface', 'edge', 'point' or 'line' (cable elements).
     nodes : (k,) int — sorted node indices.
-    elements : (m,) int — element indices (surface sets).
+    elements : (m,) int — element indices (surface sets; of ``Mesh.lines`` for line sets).
     edges : (m, 3) int — element edges as (corner, mid-side, corner) node triples (edge sets).
     """
 
@@ -49,6 +49,8 @@ class Mesh:
         (e.g. fibre directions).
     point_fields, cell_fields : name -> (n_nodes,) or (n_elements,) float — scalar fields a
         mesh file carries (e.g. a wall-pressure map for a mapped pressure).
+    lines : (n_lines, 2) int — the two nodes of each cable element (:mod:`shellsim.loads.cable`);
+        their nodes may belong to no shell element.
     """
 
     x: np.ndarray
@@ -59,6 +61,7 @@ class Mesh:
     cell_vectors: dict[str, np.ndarray] = field(default_factory=dict)
     point_fields: dict[str, np.ndarray] = field(default_factory=dict)
     cell_fields: dict[str, np.ndarray] = field(default_factory=dict)
+    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
 
     @property
     def n_nodes(self) -> int:

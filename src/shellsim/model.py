@@ -86,7 +86,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     constraints, e1f0 = _boundary_conditions(deck, mesh)
     curves = _curve_tables(deck)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
-    loads = build_loads({"load": deck.load, "contact": deck.contact},
+    loads = build_loads({"load": deck.load, "contact": deck.contact, "cable": deck.cable},
                         LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
                                   curve_index=deck.curve_index))
     return Model(
@@ -207,6 +207,7 @@ def _boundary_conditions(deck: Deck, mesh: Mesh) -> tuple[Constraints, np.ndarra
             if plane is not None:
                 planes[node].append(plane)
             director_fixed[node] |= fixed
+    director_fixed[np.setdiff1d(np.arange(n), mesh.conn)] = True  # a cable's node: no bending
     projector = np.empty((n, 3, 3))
     rot_free = np.ones((n, 2))
     e1f0 = np.empty((n, 3))

@@ -36,7 +36,7 @@ def plan(deck: Deck) -> Plan:
         "anisotropic": deck.material.ANISOTROPIC,
         "thickness_update": deck.thickness_update,
         "plane_strain": deck.section.plane_strain,
-        **load_features(deck.load + deck.contact),
+        **load_features(deck.load + deck.contact + deck.cable),
         "prescribed_motion": any(bc.type == "prescribed" for bc in deck.boundary),
         "damping": deck.solver.damping > 0.0,
     })

@@ -10,6 +10,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from ..errors import DeckError
+from ..loads import DECK_KEYS
 from .messages import format_errors
 from .curves import with_file_tables
 from .references import check_references
@@ -74,11 +75,11 @@ def _curve_files_read(deck: Deck, name: str, base_dir: Path | None) -> Deck:
 
 
 def _table_files_found(deck: Deck, name: str, base_dir: Path | None) -> Deck:
-    """``deck`` with the files its load and contact tables name (their ``FILE_KEYS``) as
+    """``deck`` with the files its load, contact and cable tables name (their ``FILE_KEYS``) as
     absolute paths, relative ones taken from the deck's folder; DeckError naming every
     file that is not there."""
     lists, problems = {}, []
-    for key in ("load", "contact"):
+    for key in DECK_KEYS:
         lists[key] = []
         for i, table in enumerate(getattr(deck, key)):
             found = {}

@@ -14,7 +14,8 @@ from .curves import Curve
 from .geometry import BUILDERS
 from ..materials.axes import CentrelineAxes, CylindricalAxes, FixedAxes, MeshAxes
 from .material import MATERIALS
-from ..loads import CONTACT_TABLES
+from ..loads import CABLE_TABLES, CONTACT_TABLES
+from ..loads.cable_laws import CABLE_LAWS
 from ..loads import TABLES as LOAD_TABLES
 from ..table_types import tag_of
 
@@ -76,6 +77,12 @@ def deck_reference() -> str:
     lines += ["## [[contact]]", "", "Chosen by `type`; the shell's faces against what they may not pass.", ""]
     for cls in CONTACT_TABLES:
         lines += _table(cls, f'### type = "{_tag(cls)}"', skip_tag=True)
+    for cls in CABLE_TABLES:
+        lines += _table(cls, "## [[cable]]")
+    lines += ["Its `law`, chosen by `model` (nominal stress P, force per initial cross-section, at the "
+              "stretch lambda; nothing in compression):", ""]
+    for cls in CABLE_LAWS:
+        lines += _table(cls, f'#### model = "{_tag(cls)}"', skip_tag=True)
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")
     lines += _table(schema.Static, "### [solver.static]")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import difflib
 
-from ..loads import measure_names
+from ..loads import DECK_KEYS, measure_names
 from .schema import Deck
 
 
@@ -31,9 +31,10 @@ def did_you_mean(word: str, choices: list[str] | tuple[str, ...]) -> str:
 
 
 def all_sets(deck: Deck, geometry_sets: dict[str, str]) -> dict[str, str]:
-    """Every named set of the scene with its kind: the geometry's, ``all``, and the deck's
-    own ``[mesh] points``."""
-    return geometry_sets | {"all": "surface"} | {name: "point" for name in deck.mesh.points}
+    """Every named set of the scene with its kind: the geometry's, ``all``, the deck's
+    own ``[mesh] points`` and the sets its cables add."""
+    added = {name: kind for table in deck.cable for name, kind in table.declared_sets.items()}
+    return geometry_sets | {"all": "surface"} | {name: "point" for name in deck.mesh.points} | added
 
 
 def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[str]:
@@ -74,10 +75,17 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
     for name in deck.mesh.points:
         if name in (geometry_sets or {}):
             problems.append(f"mesh.points.{name}: the geometry already has a set named '{name}'")
+    taken = dict.fromkeys(list(geometry_sets or {}) + ["all"] + list(deck.mesh.points), "the geometry's or [mesh] points'")
+    for i, table in enumerate(deck.cable):
+        for name in table.declared_sets:
+            if name in taken:
+                problems.append(f"cable[{i}].name: '{table.name}' adds the set '{name}', which is already "
+                                f"{taken[name]}; choose another name")
+            taken[name] = f"cable[{i}]'s"
     for i, bc in enumerate(deck.boundary):
         need_set(f"boundary[{i}].set", bc.set)
         need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))
-    for key in ("load", "contact"):
+    for key in DECK_KEYS:
         for i, table in enumerate(getattr(deck, key)):
             for name_key, name in table.named_sets.items():
                 need_set(f"{key}[{i}].{name_key}", name, table.SET_KINDS)

@@ -14,7 +14,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 from .curves import Curve
 from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
-from ..loads import CONTACT_TABLES
+from ..loads import CABLE_TABLES, CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
 from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, need_directions, repeated
 
@@ -146,9 +146,10 @@ def _chosen_by_type(tables: tuple) -> object:
     return tables[0] if len(tables) == 1 else Annotated[Union[tables], Field(discriminator="type")]
 
 
-#: A ``[[load]]`` and a ``[[contact]]`` table, among every registered kind's tables.
+#: A ``[[load]]``, a ``[[contact]]`` and a ``[[cable]]`` table, among every registered kind's tables.
 Load = _chosen_by_type(LOAD_TABLES)
 Contact = _chosen_by_type(CONTACT_TABLES)
+Cable = _chosen_by_type(CABLE_TABLES)
 
 
 class Static(Section):
@@ -469,6 +470,7 @@ class Deck(Section):
     boundary: list[Boundary] = []
     load: list[Load] = []
     contact: list[Contact] = []
+    cable: list[Cable] = []
     curves: dict[Name, Curve] = {}
     solver: Solver
     output: Output = Output()
@@ -547,6 +549,10 @@ class Deck(Section):
             problems += [f"contact[{i}].friction = {c.friction:g}: friction opposes sliding velocities, and a static "
                          "solve has none (it is frictionless); give friction = 0, or solver.method = 'explicit'"
                          for i, c in enumerate(self.contact) if c.friction]
+        if self.solver.ramp_end is not None:  # a static solve, or a static preload
+            problems += [f"cable[{i}].segments = {c.segments}: a chord's interior nodes have no stiffness while it "
+                         "is slack, so a static solve cannot find them; give segments = 1, or an explicit run "
+                         "without a preload" for i, c in enumerate(self.cable) if c.segments > 1]
         if self.solver.method == "static" and self.solver.static.control == "arc_length":
             moved = [f"boundary[{i}]" for i, b in enumerate(self.boundary) if b.type == "prescribed" and b.value != 0]
             if moved:

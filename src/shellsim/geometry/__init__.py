@@ -10,6 +10,7 @@ import numpy as np
 from ..deck import Deck, resolve_mesh_path
 from ..deck.references import check_references
 from ..errors import MeshError
+from ..loads import extend_mesh
 from ..mesh import (
     Mesh, NamedSet, averaged_directors, check_mesh, combine_surface_normals, orient_consistently,
     snap_points,
@@ -85,5 +86,5 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors,
                 point_fields=point_fields, cell_fields=cell_fields)
     check_mesh(mesh, source, deck.section.points_through_thickness)
-    return mesh
+    return extend_mesh(deck.cable, mesh)
 

@@ -37,10 +37,14 @@ and, when it has kernels of its own,
   ``farthest_moved(t, model, shape, bundle, before)``, of those near a face the one that
   moved farthest relative to it since the positions ``before`` (n, 3), by what share of
   its distance from the face;
-- where its forces couple nodes that share no element (contact between shells):
+- where its forces couple nodes that share no element (contact between shells, cables):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
-  returning how many), for the static tangent.
+  returning how many), for the static tangent;
+- where it is made of elements of its own (cables, ``[[cable]]`` tables):
+  ``extend_mesh(table, mesh)``, the mesh with its nodes and sets added (before the model
+  is built), ``add_masses(bundle, mt, mr)``, its masses added to the shell's (n,), and
+  compiled ``critical_step(shape, bundle)``, the step its elements allow on their own.
 Adding a kind is writing its module and adding it to :data:`KINDS`.
 """
 
@@ -57,17 +61,20 @@ from ..compiled_call import TypedCall
 from ..element.frames import to_rotational
 from ..errors import MeshError
 from ..mesh import node_areas
-from . import edge_pressure, mapped_pressure, nodal, pressure, rigid_tool, shell_contact
+from . import cable, edge_pressure, mapped_pressure, nodal, pressure, rigid_tool, shell_contact
 
 #: The kinds, in the order their forces are added.
-KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool, shell_contact)
+KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool, shell_contact, cable)
 
 #: The kinds with kernels of their own: the fields of :data:`Loads`.
 CARRIERS = tuple(kind for kind in KINDS if hasattr(kind, "Bundle"))
 
-#: Every ``[[load]]`` and ``[[contact]]`` deck table, and the kind that builds each.
+#: Every ``[[load]]``, ``[[contact]]`` and ``[[cable]]`` deck table, and the kind that builds each.
 TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "load")
 CONTACT_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "contact")
+CABLE_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "cable")
+#: The deck's lists of load tables, by their keys.
+DECK_KEYS = ("load", "contact", "cable")
 _KIND_OF = {table: kind for kind in KINDS for table in kind.TABLES}
 
 #: Every load of a scene (:class:`shellsim.bundles.Model`'s ``loads``): one bundle per
@@ -96,8 +103,18 @@ class LoadScene(NamedTuple):
     place: int = 0
 
 
+def extend_mesh(tables: list, mesh):
+    """``mesh`` (:class:`shellsim.mesh.Mesh`) with the nodes, elements and sets of the
+    ``tables`` whose kinds have elements of their own (cables), in order."""
+    for table in tables:
+        kind = _KIND_OF[type(table)]
+        if hasattr(kind, "extend_mesh"):
+            mesh = kind.extend_mesh(table, mesh)
+    return mesh
+
+
 def build_loads(tables: dict[str, list], scene: LoadScene) -> Loads:
-    """The deck's lists of tables (``load``, ``contact``) as the kernels' tables, in deck
+    """The deck's lists of tables (:data:`DECK_KEYS`) as the kernels' tables, in deck
     order within each kind."""
     parts: dict[type, list] = {kind.Bundle: [] for kind in CARRIERS}
     for key, listed in tables.items():
@@ -118,7 +135,7 @@ def _concatenate(bundles: list) -> NamedTuple:
 def features(tables: list) -> dict[str, bool]:
     """Every load and contact feature of the plan (:mod:`shellsim.plan`), True where
     ``tables`` use it."""
-    used = {name: False for table in TABLES + CONTACT_TABLES for name in table.FEATURES}
+    used = {name: False for table in TABLES + CONTACT_TABLES + CABLE_TABLES for name in table.FEATURES}
     for table in tables:
         used[table.feature] = True
     return used
@@ -134,6 +151,21 @@ def calibrate(model, masses: np.ndarray, rotary: np.ndarray, dt: float) -> None:
 def step_share(model) -> float:
     """The share of the structure's critical step that stays stable with every penalty."""
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)
+
+
+def stable_step(model, shape: Shape, structure: float) -> float:
+    """The critical step of the whole scene on ``shape``, from the shell structure's
+    ``structure``: that share of it the penalties leave stable, and no longer than the
+    step of any load kind's own elements (cables)."""
+    own = [kind.critical_step(shape, bundle) for kind, bundle in _with(model, "critical_step")]
+    return min([structure * step_share(model)] + own)
+
+
+def add_masses(model, mt: np.ndarray, rotary: np.ndarray) -> None:
+    """The masses of every load kind's own elements (cables) added to the shell's lumped
+    masses mt and rotary masses (n,), in place."""
+    for kind, bundle in _with(model, "add_masses"):
+        kind.add_masses(bundle, mt, rotary)
 
 
 #: The share of its offset a contact node may go through in an equilibrium, and of its

@@ -15,13 +15,14 @@ from collections.abc import Callable
 
 from numba import get_num_threads
 
+from ..bundles import Shape
 from ..deck import Deck
 from ..deck.schema import Solver
 from ..element.groups import group_count
 from ..element.tangent import BATCHES
 from ..errors import SceneTooLarge
 from ..model import Model
-from ..loads import step_share
+from ..loads import stable_step
 from .simulation import Simulation
 
 BASE_BYTES, BYTES_PER_ELEMENT = 0.4e9, 20e3
@@ -79,8 +80,8 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
     the end time with the deck's lumping and safety factor at that step (a stiffening
     scene takes more); ``seconds``, about how long they take, and ``bytes``, the memory the
     run holds. ``on_product(count)`` is told each stiffness product of the estimates."""
-    share = step_share(model)  # what contact springs leave of it
-    critical = {mass: share * Simulation(model._replace(mass=mass)).critical_time_step(on_product)
+    initial = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
+    critical = {mass: stable_step(model, initial, Simulation(model._replace(mass=mass)).critical_time_step(on_product))
                 for mass in ("M1", "M2")}
     dt = time_step(deck.solver, critical[deck.solver.mass])
     steps, seconds = stepping(deck.solver.end_time, dt, model.n_elements)

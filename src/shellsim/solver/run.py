@@ -22,7 +22,7 @@ from ..curve_tables import factor
 from ..deck import Deck
 from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
-from ..loads import ToolForces, calibrate, measure_names, step_share
+from ..loads import ToolForces, calibrate, measure_names, stable_step
 from ..mesh import Mesh
 from ..model import Model
 from .probes import Probe, probe_value, resolve_probes
@@ -248,7 +248,7 @@ def _update_time_step(run: Run, listener: Listener) -> None:
     if run.lowest is None or run.worst.ratio < run.lowest.ratio:
         run.lowest = run.worst
     run.sim.update_masses()
-    run.dt_critical = run.sim.critical_time_step() * step_share(run.model)
+    run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, run.sim.critical_time_step())
     run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
     listener.on_dt(run)

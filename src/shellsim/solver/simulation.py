@@ -15,6 +15,7 @@ from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
 from ..compiled_call import TypedCall
 from ..errors import NumericalError
+from ..loads import add_masses
 from ..model import Model
 from . import explicit
 from .timestep import critical_time_step
@@ -67,9 +68,10 @@ class Simulation:
         self.evaluate_forces()
 
     def update_masses(self) -> None:
-        """Lumped masses on the current configuration (M1 or M2, thesis 3.14)."""
+        """Lumped masses on the current configuration (M1 or M2, thesis 3.14), the cables' added."""
         m, s = self.model, self.state
         self.compiled.masses(m.rule, m.body, s.fields.shape, float(m.density), m.mass == "M1", s.mt, s.mr)
+        add_masses(m, s.mt, s.mr)
 
     def volume(self, initial: bool = False) -> float:
         """Volume of the shell body now (or at the start) [length^3]: int dv over every

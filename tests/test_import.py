@@ -74,12 +74,18 @@ BEAM_TIP = -3e-3 * 10.0**3 / (3 * 2e5 * 1.0 * 0.1**3 / 12)
 
 def tip_deflection(done, tip: str) -> float:
     """The final z displacement of the set ``tip`` of an imported strip solved as its deck says."""
+    return tip_deflection_along(done, tip, "z")
+
+
+def tip_deflection_along(done, tip: str, component: str) -> float:
+    """The final displacement along ``component`` of the set ``tip`` of an imported model
+    solved as its deck says."""
     done.deck.write_text(done.deck.read_text() + f'''
 [[output.probe]]
 name = "tip"
 quantity = "displacement"
 set = "{tip}"
-component = "z"
+component = "{component}"
 ''')
     run = run_deck(load_deck(done.deck), done.deck.parent)
     assert run.status == "completed"
@@ -186,22 +192,22 @@ def test_new_mid_edge_nodes_lie_on_a_curved_surface_not_on_its_chords():
 
 
 def test_what_cannot_come_over_is_listed_with_its_line_and_a_mesh_deck_refuses_it(strip, tmp_path):
-    """Cable elements, a user material, a keyword shellsim does not read and a second step
-    each named with file and line; the import still writes the deck (its problems say
-    what to edit: a material), while a deck reading the file's mesh refuses the cables."""
-    extra_model = "*Element, type=T3D2, elset=Chords\n900, 1, 2\n*Equation\n2\n1, 1, 1., 2, 1, -1."
+    """3-node line elements, a user material, a keyword shellsim does not read and a second
+    step each named with file and line; the import still writes the deck (its problems say
+    what to edit: a material), while a deck reading the file's mesh refuses the lines."""
+    extra_model = "*Element, type=T3D3, elset=Chords\n900, 1, 2, 3\n*Equation\n2\n1, 1, 1., 2, 1, -1."
     path = strip(extra_model=extra_model)
     text = path.read_text().replace("*Elastic\n200000., 0.0", "*User Material, constants=2\n1., 2.")
     path.write_text(text + "*Step\n*Static\n*End Step\n")
     done = import_model(path, tmp_path / "imported")
     listed = "\n".join(done.unmapped)
-    for pattern in (r"1 T3D2 element\(s\) \(first at strip\.inp:\d+\)", r"\*USER MATERIAL \(strip\.inp:\d+\).*lee_sacks",
+    for pattern in (r"1 T3D3 element\(s\) \(first at strip\.inp:\d+\)", r"\*USER MATERIAL \(strip\.inp:\d+\).*lee_sacks",
                     r"\*EQUATION \(strip\.inp:\d+\): not read", r"\*STEP \(strip\.inp:\d+\): only the first step"):
         assert re.search(pattern, listed), pattern
     assert any("material" in p for p in done.problems)
     for line in done.unmapped:
         assert line in done.deck.read_text()
-    with pytest.raises(MeshError, match=r"T3D2.*strip\.inp:\d+"):
+    with pytest.raises(MeshError, match=r"T3D3.*strip\.inp:\d+"):
         read_mesh(path)
 
 
@@ -434,3 +440,46 @@ def test_a_pipe_named_as_a_model_is_refused_not_read(tmp_path):
     (tmp_path / "model.inp").write_text("*Include, input=pipe.inp\n")
     with pytest.raises(MeshError, match=r"\*INCLUDE \(model\.inp:1\): .*pipe\.inp' is not a regular file"):
         read_foreign(tmp_path / "model.inp")
+
+
+def tethered_plate_inp(line: str = "T3D2", section: str = "*Solid Section, elset=Chord, material=Cord\n0.5") -> str:
+    """A clamped S4R plate 1 x 1 and a cable (a ``line`` element) of length 1 from its
+    corner (2; pinned) along x to a node of its own (5), held across and pulled along
+    it by a force of 100 in a static step; the cable's ``section`` area 0.5, E = 1000."""
+    return "\n".join([
+        "*Heading", " a plate and a chord", "*Node", "1, 0., 0., 0.", "2, 1., 0., 0.", "3, 1., 1., 0.", "4, 0., 1., 0.",
+        "5, 2., 0., 0.", "*Element, type=S4R, elset=Plate", "1, 1, 2, 3, 4", f"*Element, type={line}, elset=Chord",
+        "10, 2, 5", "*Nset, nset=Root", "1, 4", "*Nset, nset=End", "5",
+        "*Shell Section, elset=Plate, material=Skin", "0.1", section,
+        "*Material, name=Skin", "*Density", "1e-9", "*Elastic", "1000000., 0.3",
+        "*Material, name=Cord", "*Density", "1.1e-9", "*Elastic", "1000., 0.3",
+        "*Boundary", "Root, ENCASTRE", "2, PINNED", "End, 2, 3",
+        "*Step, nlgeom=YES", "*Static", "0.25, 1.", "*Cload", "End, 1, 100.", "*End Step"]) + "\n"
+
+
+def test_truss_elements_come_over_as_cables_that_stretch_as_their_law_says(tmp_path):
+    """A T3D2 truss comes over as a cable: its node that no shell has kept, its element set
+    a line set of the written mesh (and of the file read as a deck's mesh), a [[cable]]
+    table with its section's area, its material's E and density; solved as the deck says,
+    the chord pulled by F = 100 with EA = 500 stretches by F / EA = 0.2 (the linear law's
+    closed form) to 1e-9. A B31 beam comes over the same way, its area pi r^2 from a
+    circular section, listed as carrying tension only."""
+    path = tmp_path / "tethered.inp"
+    path.write_text(tethered_plate_inp())
+    done = import_model(path, tmp_path / "imported")
+    assert done.problems == [] and done.sets["Chord"] == "line"
+    written, direct = read_mesh(done.mesh), read_mesh(path)
+    for mesh in (written, direct):
+        assert len(mesh.lines) == 1 and mesh.sets["Chord"].kind == "line"
+        np.testing.assert_allclose(mesh.x[mesh.lines[0]], [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    deck = load_deck(done.deck)
+    cable, = deck.cable
+    assert (cable.set, cable.area, cable.density, cable.law.model, cable.law.E) == ("Chord", 0.5, 1.1e-9, "linear",
+                                                                                   1000.0)
+    assert tip_deflection_along(done, "End", "x") == pytest.approx(100.0 / 500.0, rel=1e-9)
+    beam = tmp_path / "beam.inp"
+    beam.write_text(tethered_plate_inp("B31", "*Beam Section, elset=Chord, material=Cord, section=CIRC\n0.4"))
+    model = read_foreign(beam)
+    assert model.tables["cable"][0]["area"] == pytest.approx(np.pi * 0.16)
+    assert any(re.search(r"1 B31 beam element\(s\) \(first at beam\.inp:\d+\).*tension only", line)
+               for line in model.unmapped)

@@ -174,7 +174,9 @@ def import_model(
     with err.status(f"reading {model}"):
         done = bring_over(model, folder)
     sets = ", ".join(f"{name} ({kind})" for name, kind in sorted(done.sets.items()))
-    out.print(f"{escape(str(model))}: {done.elements} elements; sets: {escape(sets) or 'none'}", highlight=False)
+    cables = f", {done.cables} cable elements" if done.cables else ""
+    out.print(f"{escape(str(model))}: {done.elements} elements{cables}; sets: {escape(sets) or 'none'}",
+              highlight=False)
     if done.unmapped:
         err.print("[yellow]not brought over[/] (listed at the top of the deck too):")
         for line in done.unmapped:

@@ -16,17 +16,19 @@ from .output.folder import output_folder, write_atomically
 
 DECK_NAME = "deck.toml"
 #: The deck's tables in the order a reader expects them.
-ORDER = ("meta", "geometry", "material", "section", "boundary", "load", "contact", "curves", "solver")
+ORDER = ("meta", "geometry", "material", "section", "boundary", "load", "contact", "cable", "curves", "solver")
 
 
 @dataclass(frozen=True)
 class Imported:
-    """What ``shellsim import`` wrote: the deck, the mesh, the sets, the lines of what was
-    not brought over and the deck's problems (empty when it runs as written)."""
+    """What ``shellsim import`` wrote: the deck, the mesh, its shell and cable element
+    counts, the sets, the lines of what was not brought over and the deck's problems
+    (empty when it runs as written)."""
 
     deck: Path
     mesh: Path
     elements: int
+    cables: int
     sets: dict[str, str]
     unmapped: list[str]
     problems: list[str]
@@ -49,13 +51,13 @@ def import_model(source: Path, folder: Path) -> Imported:
     m = model.mesh
     thickness = m.thickness if m.thickness is not None else np.full(len(m.x), model.tables["section"]["thickness"])
     mesh = Mesh(x=m.x, conn=m.conn, director=m.director, thickness=thickness, sets=m.sets,
-                cell_vectors=m.cell_vectors, point_fields=m.point_fields, cell_fields=m.cell_fields)
+                cell_vectors=m.cell_vectors, point_fields=m.point_fields, cell_fields=m.cell_fields, lines=m.lines)
     write_mesh_vtu(mesh, mesh_path, with_thickness=m.thickness is not None)
     tables = model.tables | {"geometry": {"builder": "file", "path": mesh_path.name}}
     text = _header(source, model.unmapped) + deck_text({key: tables[key] for key in ORDER if key in tables})
     write_atomically(deck_path, text)
-    return Imported(deck_path, mesh_path, len(m.conn), {name: s.kind for name, s in m.sets.items()}, model.unmapped,
-                    _problems(deck_path))
+    sets = {name: s.kind for name, s in m.sets.items()}
+    return Imported(deck_path, mesh_path, len(m.conn), len(m.lines), sets, model.unmapped, _problems(deck_path))
 
 
 def deck_text(tables: dict) -> str:

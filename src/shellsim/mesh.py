@@ -248,7 +248,7 @@ def mid_surface_area(mesh: Mesh, n_gauss: int = 3) -> float:
 
 def edges_within(conn: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     """Element edges whose three nodes all belong to ``nodes``, each once: (m, 3)."""
-    member = np.zeros(conn.max() + 1, dtype=bool)
+    member = np.zeros(max(conn.max(), np.max(nodes, initial=0)) + 1, dtype=bool)  # a cable's nodes come last
     member[nodes] = True
     triples = conn[:, EDGES].reshape(-1, 3)
     inside = triples[member[triples].all(axis=1)]

@@ -1,7 +1,8 @@
 """An Abaqus shell model as a shellsim mesh and deck tables.
 
 Shells (S4, S4R, S8R, S9R5 and their variants) become 9-node quads (:mod:`.quad_upgrade`;
-triangles S3, S3R split into quads first),
+triangles S3, S3R split into quads first), 2-node trusses and beams (T3D2, B31) cables with
+their section's area and a 1D law of their material,
 their node and element sets and element-based surfaces named sets, ``*ORIENTATION`` (with
 per-element ``*DISTRIBUTION``) material axes; the model data and the first step become the
 deck's material, section, boundaries, loads, contact, curves and solver. Every keyword,
@@ -29,11 +30,14 @@ from .shell_mesh import ShellMesh, deck_name, listed
 #: Abaqus shell types by their number of nodes.
 SHELLS = {3: {"S3", "S3R", "S3RS", "STRI3"}, 4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"},
           9: {"S9R5"}}
+#: Abaqus' 2-node line elements, brought over as cables (tension only: a beam's bending and
+#: a truss' compression are dropped, and listed).
+LINES = {"T3D2", "T3D2H", "B31", "B31H"}
 #: Why other element types cannot come over.
 NOT_SHELLS = {
     "STRI65": "6-node triangles: bring them as 3-node ones (S3)",
-    "T3D2": "line elements (cables, chordae) are not yet shellsim elements",
-    "B31": "beam elements are not shellsim elements",
+    "T3D3": "3-node line elements: bring them as 2-node ones (T3D2), which come over as cables",
+    "B32": "3-node beams: bring them as 2-node ones (B31), which come over as cables",
     "M3D4": "membranes: shellsim's shells carry bending; model the membrane as a thin shell",
 }
 #: Abaqus' named boundary types: the degrees of freedom they fix.
@@ -74,7 +78,10 @@ class _Builder:
             by_kind[e.kind].append(e)
         shells = {size: [e for kind in kinds for e in by_kind.get(kind, [])] for size, kinds in SHELLS.items()}
         for kind, elements in sorted(by_kind.items()):
-            if not any(kind in kinds for kinds in SHELLS.values()):
+            if kind in LINES and kind.startswith("B"):
+                m.unmapped.append(f"{len(elements)} {kind} beam element(s) (first at {elements[0].where}): brought over "
+                                  "as cables, which carry tension only (no bending, no compression)")
+            elif kind not in LINES and not any(kind in kinds for kinds in SHELLS.values()):
                 why = next((text for prefix, text in NOT_SHELLS.items() if kind.startswith(prefix)),
                            "not a shell element shellsim has")
                 self.unused_elements.append(f"{len(elements)} {kind} element(s) (first at {elements[0].where}): {why}")
@@ -92,6 +99,13 @@ class _Builder:
                                 f"{size} nodes; got {', '.join(e.nodes)}")
         positions = {label: m.coords[i] for label, i in m.nodes.items()}
         self.shells = ShellMesh(m.path, positions, [(e.label, e.nodes, e.where) for e in elements])
+        lines = [e for kind in sorted(LINES) for e in by_kind.get(kind, [])]
+        for e in lines:
+            if len(e.nodes) != 2:
+                raise MeshError(f"model file '{m.path}', element {e.label} ({e.where}): a {e.kind} has 2 nodes; "
+                                f"got {', '.join(e.nodes)}")
+        if lines:
+            self.shells.add_lines(positions, [(e.label, e.nodes, e.where) for e in lines])
         m.unmapped.extend(self.shells.notes)
         self._named_sets()
 
@@ -101,6 +115,9 @@ class _Builder:
             elements = self.shells.elements_of(named.items)
             if len(elements):
                 self.shells.add_set(("elset", key), named.name, self.shells.surface_set(elements))
+            lines = self.shells.line_set(named.items)
+            if lines is not None:  # beside the shells' surface set, if the set has both
+                self.shells.add_set(("lines", key), named.name + ("_cables" if len(elements) else ""), lines)
         for key, named in m.nsets.items():
             nodes = self.shells.nodes_of(named.items)
             if not len(nodes):
@@ -140,8 +157,14 @@ class _Builder:
         covered = np.zeros(len(self.shells.conn), dtype=bool)
         thickness = np.full(len(self.shells.conn), np.nan)
         chosen = None
+        cables = []
         for k, elset, prefix in m.sections:
             elements = self.shells.elements_of(m.elsets[elset].items)
+            if ("lines", elset) in self.shells.set_of:
+                cable = self._cable(k, self.shells.set_of[("lines", elset)])
+                cables += [cable] if cable is not None else []
+                if not len(elements):
+                    continue
             if k.name != "shell section":
                 m.unmapped.append(f"{k.label()}: a {k.name} is not a shellsim section; its elements are left without one")
                 continue
@@ -180,13 +203,63 @@ class _Builder:
             count = np.zeros(len(self.shells.x))
             np.add.at(total, self.shells.conn, thickness[:, None])
             np.add.at(count, self.shells.conn, 1.0)
-            self.shells.thickness = total / count
+            self.shells.thickness = total / np.maximum(count, 1.0)  # a cable's own node: 0
         material = self._material(*chosen)
         if material is not None:
             if material["model"] != "linear_elastic" or "nlgeom" in self._step_params():
                 section["technique"] = 1
             self.tables["material"] = material
         self.tables["section"] = section
+        if cables:
+            self.tables["cable"] = cables
+
+    def _cable(self, k: Keyword, lines: str) -> dict | None:
+        """The cable table of the section ``k`` on the line set ``lines``: its area (a solid
+        section's, or a circular beam section's pi r^2) and its material's 1D law and
+        density; None (listed) where either does not map."""
+        m = self.model
+        row = [float(v) for v in k.rows[0] if _is_number(v)] if k.rows else []
+        if k.name == "solid section":
+            area = row[0] if row else 1.0  # Abaqus' default cross-section of a truss
+        elif k.name == "beam section" and (k.param("section") or "").lower() == "circ" and row:
+            area = float(np.pi * row[0] ** 2)
+        else:
+            m.unmapped.append(f"{k.label()}: a {k.name} of section type {k.param('section')} gives no cross-section "
+                              f"shellsim reads (a *SOLID SECTION's area, a circular *BEAM SECTION's radius); the "
+                              f"cables of '{lines}' are left out")
+            return None
+        key = (k.param("material") or "").lower()
+        if key not in m.materials:
+            raise MeshError(f"{k.label()}: unknown material '{k.param('material')}'")
+        material, options = m.materials[key]
+        by_name = {o.name: o for o in options}
+        law = self._cable_law(by_name)
+        if law is None:
+            m.unmapped.append(f"{material.label()}: material '{material.param('name')}' of the cables of '{lines}' has "
+                              "no 1D law shellsim maps (*ELASTIC, *HYPERELASTIC NEO HOOKE or OGDEN N=1); they are "
+                              "left out")
+            return None
+        density = by_name.get("density")
+        if density is None:
+            m.unmapped.append(f"{material.label()}: material '{material.param('name')}' of the cables of '{lines}' has "
+                              "no *DENSITY; the cable's density 1.0 is a placeholder (only an explicit run uses it)")
+        return {"name": deck_name(f"{lines}_cable", "cable"), "set": lines, "area": area,
+                "density": float(density.rows[0][0]) if density is not None else 1.0, "law": law}
+
+    @staticmethod
+    def _cable_law(by_name: dict[str, Keyword]) -> dict | None:
+        """The 1D law of a material's options (by name), None where none maps."""
+        if "hyperelastic" in by_name:
+            k = by_name["hyperelastic"]
+            row = [float(v) for v in k.rows[0]] if k.rows else []
+            if "neo hooke" in k.params and row:
+                return {"model": "neo_hookean", "mu": 2.0 * row[0]}
+            if "ogden" in k.params and int(k.param("n") or 1) == 1 and len(row) >= 2:
+                return {"model": "ogden", "mu": row[0], "alpha": row[1]}
+            return None
+        if "elastic" in by_name and by_name["elastic"].rows:
+            return {"model": "linear", "E": float(by_name["elastic"].rows[0][0])}
+        return None
 
     def _step_params(self) -> dict[str, str]:
         step = self.model.steps[0][0].params if self.model.steps else {}

@@ -74,6 +74,41 @@ class ShellMesh:
         self.point_fields: dict[str, np.ndarray] = {}
         self.cell_vectors: dict[str, np.ndarray] = {}
         self.thickness: np.ndarray | None = None
+        self.shell_nodes = len(x9)  # the cables' own nodes come after
+        self.lines = np.zeros((0, 2), dtype=np.int64)
+        self.line_of_label: dict[str, int] = {}
+
+    def add_lines(self, positions: dict[str, np.ndarray], lines: list[tuple[str, list[str], str]]) -> None:
+        """The file's 2-node line elements (label, node labels, where) as cables: their
+        nodes that no shell has appended (their directors along the line, which no cable
+        uses), the elements as :attr:`lines` (L, 2), found by label in ``line_of_label``."""
+        ends = [nodes for _, nodes, _ in lines]
+        new = [label for label in dict.fromkeys(n for pair in ends for n in pair) if label not in self.index_of_label]
+        missing = [label for label in new if label not in positions]
+        if missing:
+            raise MeshError(f"model file '{self.path}': line elements use nodes that are not defined: {listed(missing)}")
+        for label, nodes, where in lines:
+            if nodes[0] == nodes[1]:
+                raise MeshError(f"model file '{self.path}', element {label} ({where}): both ends are node {nodes[0]}")
+        self.index_of_label |= {label: len(self.x) + i for i, label in enumerate(new)}
+        self.lines = np.asarray([[self.index_of_label[a], self.index_of_label[b]] for a, b in ends], dtype=np.int64)
+        self.line_of_label = {label: i for i, (label, _, _) in enumerate(lines)}
+        self.x = np.vstack([self.x, np.asarray([positions[label] for label in new], dtype=float).reshape(-1, 3)])
+        along = self.x[self.lines[:, 1]] - self.x[self.lines[:, 0]]
+        director = np.tile([0.0, 0.0, 1.0], (len(new), 1))
+        owner = self.lines[:, 1] >= self.shell_nodes
+        director[self.lines[owner, 1] - self.shell_nodes] = along[owner]
+        owner = self.lines[:, 0] >= self.shell_nodes
+        director[self.lines[owner, 0] - self.shell_nodes] = along[owner]
+        self.director = np.vstack([self.director, director / np.linalg.norm(director, axis=1, keepdims=True)])
+
+    def line_set(self, labels) -> NamedSet | None:
+        """The line set of the file's line elements ``labels`` (None where it names none)."""
+        elements = np.unique([self.line_of_label[label] for label in labels if label in self.line_of_label])
+        if not len(elements):
+            return None
+        elements = elements.astype(np.int64)
+        return NamedSet("line", np.unique(self.lines[elements]), elements=elements)
 
     def elements_of(self, labels) -> np.ndarray:
         """The mesh elements (sorted) made from the file's elements ``labels``."""
@@ -85,9 +120,12 @@ class ShellMesh:
         return list(dict.fromkeys(self.labels[p] for p in self.parent[chosen]))
 
     def nodes_of(self, labels, lift: bool = True) -> np.ndarray:
-        """The mesh nodes of the file's node ``labels`` and, with ``lift``, the new nodes they span."""
+        """The mesh nodes of the file's node ``labels`` and, with ``lift``, the new nodes the
+        shells' among them span (a cable's own node spans none)."""
         given = np.unique([self.index_of_label[label] for label in labels if label in self.index_of_label])
-        return self.lift(given.astype(np.int64)) if len(given) and lift else given.astype(np.int64)
+        given = given.astype(np.int64)
+        shells = given[given < self.shell_nodes]
+        return np.union1d(self.lift(shells), given[given >= self.shell_nodes]) if len(shells) and lift else given
 
     def surface_set(self, elements: np.ndarray) -> NamedSet:
         return NamedSet("surface", np.unique(self.conn[elements]), elements=elements)
@@ -129,7 +167,7 @@ class ShellMesh:
 
     def imported(self) -> ImportedMesh:
         return ImportedMesh(self.x, self.conn, self.sets, self.director, self.thickness, self.cell_vectors,
-                            self.point_fields, {})
+                            self.point_fields, {}, self.lines)
 
 
 def deck_name(wanted: str, lead: str) -> str:

@@ -34,6 +34,7 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     cell_vectors: dict[str, np.ndarray] = {}
     point_fields: dict[str, np.ndarray] = {}
     cell_fields: dict[str, np.ndarray] = {}
+    lines = np.zeros((0, 2), dtype=np.int64)  # a mesh file's cables
     remeshed = g.builder == "file" and g.surface
     if remeshed:
         from .session import gmsh_session
@@ -53,6 +54,7 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
         imported = read_mesh(path)
         x, conn, sets = imported.x, imported.conn, imported.sets
         director, thickness, cell_vectors = imported.director, imported.thickness, imported.cell_vectors
+        lines = imported.lines
         point_fields, cell_fields = imported.point_fields, imported.cell_fields
         preferred = director[conn[:, 8]] if director is not None else None
     else:
@@ -80,11 +82,11 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     if thickness is None:
         thickness = np.full(len(x), deck.section.thickness)
     all_elements = np.arange(len(conn))
-    sets = sets | {"all": NamedSet("surface", np.arange(len(x)), elements=all_elements)}
+    sets = sets | {"all": NamedSet("surface", np.unique(conn), elements=all_elements)}
     # on a remeshed surface nobody knows where the nodes are: the nearest within half an element
     sets = sets | snap_points(x, deck.mesh.points, 0.5 * g.element_size if remeshed else None)
     mesh = Mesh(x=x, conn=conn, director=director, thickness=thickness, sets=sets, cell_vectors=cell_vectors,
-                point_fields=point_fields, cell_fields=cell_fields)
+                point_fields=point_fields, cell_fields=cell_fields, lines=lines)
     check_mesh(mesh, source, deck.section.points_through_thickness)
     return extend_mesh(deck.cable, mesh)
 

@@ -5,15 +5,17 @@ Named sets come from
 - cell sets (gmsh physical groups, in the 2.2 and 4.x formats; a group over several
   entities is merged): on quad9 cells a surface set, on 3-node lines an edge set, on
   vertices a point set;
-- point-data arrays ``set_<name>`` (nonzero = member; 1 point, 2 edge, 3 surface set), as
-  :func:`shellsim.output.mesh_files.write_mesh_vtu` writes them.
+- point-data arrays ``set_<name>`` (nonzero = member; 1 point, 2 edge, 3 surface, 4 line
+  set), as :func:`shellsim.output.mesh_files.write_mesh_vtu` writes them; the cables are the
+  2-node lines marked by the cell data ``cable`` (their nodes kept though no shell has
+  them), a line set's members its cells marked by its ``set_<name>`` cell data.
 Point data ``director`` (n, 3) and ``thickness`` (n,) are used when present, and cell data
 of three components on the quad9 cells (e.g. fibre directions) is kept by name.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +28,9 @@ from .file_checks import (
 )
 
 SET_PREFIX = "set_"
-KIND_CODE = {"point": 1, "edge": 2, "surface": 3}
+KIND_CODE = {"point": 1, "edge": 2, "surface": 3, "line": 4}
+#: The cell data that marks a line block's cells as cables (:func:`shellsim.output.mesh_files.write_mesh_vtu`).
+CABLE_MARK = "cable"
 _KIND_OF_CODE = {v: k for k, v in KIND_CODE.items()}
 _KIND_OF_CELL = {"quad9": "surface", "line3": "edge", "line": "edge", "vertex": "point"}
 _DIMENSION = {"quad9": 2, "line3": 1, "line": 1, "vertex": 0}
@@ -39,7 +43,7 @@ _NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", 
 class ImportedMesh:
     """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and
     thickness (n,), per-element vectors (ne, 3) and scalar fields per node (n,) and per
-    element (ne,) by name."""
+    element (ne,) by name; lines (L, 2) its cable elements (their nodes may be on no shell)."""
 
     x: np.ndarray
     conn: np.ndarray
@@ -49,6 +53,7 @@ class ImportedMesh:
     cell_vectors: dict[str, np.ndarray]
     point_fields: dict[str, np.ndarray]
     cell_fields: dict[str, np.ndarray]
+    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
 
 
 def read_mesh(path: Path) -> ImportedMesh:
@@ -72,7 +77,11 @@ def read_mesh(path: Path) -> ImportedMesh:
     _refuse(path, [p for block in m.cells
                    for p in missing_nodes_problem(block.type, np.asarray(block.data, dtype=np.int64), len(m.points))])
     conn_raw = np.concatenate([np.asarray(m.cells[i].data, dtype=np.int64) for i in blocks])
-    used = np.unique(conn_raw)
+    cable_blocks = [i for i, block in enumerate(m.cells)
+                    if block.type == "line" and np.any(np.asarray(m.cell_data.get(CABLE_MARK, [[]] * len(m.cells))[i]))]
+    lines_raw = np.concatenate([np.zeros((0, 2), dtype=np.int64)]
+                               + [np.asarray(m.cells[i].data, dtype=np.int64) for i in cable_blocks])
+    used = np.concatenate([np.unique(conn_raw), np.setdiff1d(lines_raw, conn_raw)])  # the cables' own nodes last
     index = np.full(len(m.points), -1)
     index[used] = np.arange(len(used))
     x = np.asarray(m.points, dtype=float)[used]
@@ -91,7 +100,10 @@ def read_mesh(path: Path) -> ImportedMesh:
         return values.reshape(len(m.points), width)[used] if width else values.reshape(len(m.points))[used]
 
     director, thickness = point_array("director", 3), point_array("thickness", None)
-    problems = repeated_node_problem(conn_raw) + point_data_problems(x, director, thickness, node_ids=used + 1)
+    shell = len(used) - len(np.setdiff1d(lines_raw, conn_raw))  # a cable's own node has no thickness to check
+    problems = repeated_node_problem(conn_raw) + point_data_problems(
+        x[:shell], None if director is None else director[:shell], None if thickness is None else thickness[:shell],
+        node_ids=used[:shell] + 1)
     if not problems:
         problems = collapsed_problem(x, conn)
     _refuse(path, problems)
@@ -99,17 +111,23 @@ def read_mesh(path: Path) -> ImportedMesh:
         director = director / np.linalg.norm(director, axis=1, keepdims=True)
 
     sets = _cell_sets(path, m, blocks, offsets, index, conn)
+    lines = index[lines_raw]
     point_fields = {}
     for key in m.point_data:
         if key.startswith(SET_PREFIX):
             values = np.nan_to_num(point_array(key, None))
             code = int(values.max(initial=0))
-            if code in _KIND_OF_CODE:
+            if _KIND_OF_CODE.get(code) == "line":
+                members = np.concatenate([np.zeros(0)] + [np.asarray(m.cell_data[key][i]).reshape(-1)
+                                                          for i in cable_blocks if key in m.cell_data])
+                elements = np.flatnonzero(members)
+                sets[key[len(SET_PREFIX):]] = NamedSet("line", np.unique(lines[elements]), elements=elements)
+            elif code in _KIND_OF_CODE:
                 sets[key[len(SET_PREFIX):]] = _node_set(_KIND_OF_CODE[code], np.flatnonzero(values), conn)
         elif key not in ("director", "thickness") and np.asarray(m.point_data[key]).size == len(m.points):
             point_fields[key] = _finite(path, "point", key, point_array(key, None), used + 1)
     vectors, cell_fields = _cell_arrays(path, m, blocks)
-    return ImportedMesh(x, conn, sets, director, thickness, vectors, point_fields, cell_fields)
+    return ImportedMesh(x, conn, sets, director, thickness, vectors, point_fields, cell_fields, lines)
 
 
 def _finite(path: Path, where: str, name: str, values: np.ndarray, ids: np.ndarray) -> np.ndarray:

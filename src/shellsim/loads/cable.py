@@ -1,9 +1,10 @@
-"""Cables (chordae tendineae): two-node elements that carry tension only, from the nodes of
-a shell set to a tip point (a papillary muscle's), each chord in ``segments`` elements.
+"""Cables (chordae tendineae): two-node elements that carry tension only, either from the
+nodes of a shell set to a tip point (a papillary muscle's), each chord in ``segments``
+elements, or the line elements of a mesh file's line set (an imported model's).
 
-A ``[[cable]]`` table adds its nodes to the mesh (:func:`extend_mesh`): the interior nodes
-of every chord and one tip node shared by the table's chords, as the point set
-``<name>_tip`` (so that a ``[[boundary]]`` may hold it or move it on a curve), and its
+A ``[[cable]]`` table with a ``tip`` adds its nodes to the mesh (:func:`extend_mesh`): the
+interior nodes of every chord and one tip node shared by the table's chords, as the point
+set ``<name>_tip`` (so that a ``[[boundary]]`` may hold it or move it on a curve), and its
 elements as the line set ``<name>``. A cable node that belongs to no shell has its
 director fixed (a cable has no bending).
 
@@ -24,6 +25,7 @@ from typing import ClassVar, Literal, NamedTuple
 
 import numpy as np
 from numba import njit
+from pydantic import model_validator
 
 from ..errors import MeshError
 from ..mesh import Mesh, NamedSet
@@ -34,7 +36,8 @@ from .table import LoadTable
 
 class Cable(LoadTable):
     """Chords from every node of ``set`` to the point ``tip``, each in ``segments``
-    elements of cross-section ``area`` [length^2] and ``density`` [mass/length^3], with
+    elements (or, without a ``tip``, the elements of the mesh file's line set ``set``), of
+    cross-section ``area`` [length^2] and ``density`` [mass/length^3], with
     the 1D ``law``; ``rest_length``: each chord's rest length over its initial length
     (above 1 slack, below 1 pre-tensioned); ``gravity`` [length/time^2]: the acceleration
     its weight follows (the shell's weight is a ``body_force`` load). The table adds the
@@ -47,7 +50,7 @@ class Cable(LoadTable):
     type: Literal["cable"] = "cable"
     name: Name
     set: Name
-    tip: Vec3
+    tip: Vec3 | None = None
     segments: Count = 1
     area: Positive
     density: Positive
@@ -55,21 +58,34 @@ class Cable(LoadTable):
     rest_length: Positive = 1.0
     gravity: Vec3 = (0.0, 0.0, 0.0)
     DECK_KEY: ClassVar[str] = "cable"
-    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface")
+    SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface", "line")
     FEATURES: ClassVar[tuple[str, ...]] = ("cables",)
+
+    @model_validator(mode="after")
+    def _segments_need_a_tip(self) -> "Cable":
+        if self.tip is None and self.segments != 1:
+            raise ValueError(f"segments = {self.segments} divides chords made to a tip; a mesh file's line set "
+                             "brings its own elements (give a tip, or leave segments out)")
+        return self
 
     @property
     def summary(self) -> str:
         """One line for ``shellsim check``."""
         law = ", ".join(f"{k}={v:g}" for k, v in self.law.model_dump().items() if k != "model")
         slack = f", rest length x {self.rest_length:g}" if self.rest_length != 1.0 else ""
-        return (f"'{self.name}': a chord from each node of '{self.set}' to {list(self.tip)} in {self.segments} "
-                f"segment(s), area {self.area:g}, {self.law.model} ({law}){slack}")
+        chords = (f"the line elements of '{self.set}'" if self.tip is None else
+                  f"a chord from each node of '{self.set}' to {list(self.tip)} in {self.segments} segment(s)")
+        return f"'{self.name}': {chords}, area {self.area:g}, {self.law.model} ({law}){slack}"
 
     @property
     def declared_sets(self) -> dict[str, str]:
-        """The sets the table adds to the mesh, with their kinds."""
-        return {self.name: "line", f"{self.name}_tip": "point"}
+        """The sets the table adds to the mesh, with their kinds (none without a tip)."""
+        return {} if self.tip is None else {self.name: "line", f"{self.name}_tip": "point"}
+
+    @property
+    def elements(self) -> str:
+        """The line set that holds the table's elements."""
+        return self.set if self.tip is None else self.name
 
 
 TABLES = (Cable,)
@@ -78,7 +94,14 @@ TABLES = (Cable,)
 def extend_mesh(table: Cable, mesh: Mesh) -> Mesh:
     """``mesh`` with ``table``'s chords: their new nodes appended (directors along the
     chord, no thickness, 0 in the point fields), their elements appended to ``mesh.lines``,
-    and the sets :attr:`Cable.declared_sets`."""
+    and the sets :attr:`Cable.declared_sets`; without a tip, ``mesh`` itself, once its set
+    is found to be a line set (MeshError otherwise)."""
+    kind = mesh.sets[table.set].kind
+    if (kind == "line") != (table.tip is None):
+        need = "a tip to run its chords to" if table.tip is None else "no tip: its line elements are the chords"
+        raise MeshError(f"cable '{table.name}': set '{table.set}' is a {kind} set, which needs {need}")
+    if table.tip is None:
+        return mesh
     starts = mesh.sets[table.set].nodes
     tip = np.asarray(table.tip, dtype=float)
     chords = tip - mesh.x[starts]
@@ -136,7 +159,7 @@ def build(table: Cable, scene) -> Bundle:
     """The elements :func:`extend_mesh` made for ``table``, at rest ``rest_length`` times
     their initial length."""
     mesh = scene.mesh
-    nodes = mesh.lines[mesh.sets[table.name].elements]
+    nodes = mesh.lines[mesh.sets[table.elements].elements]
     count = len(nodes)
     code, params = code_and_parameters(table.law)
     return Bundle(nodes=nodes, rest=table.rest_length * np.linalg.norm(mesh.x[nodes[:, 1]] - mesh.x[nodes[:, 0]], axis=1),
@@ -203,6 +226,15 @@ def couplings(t, model, shape, cables, step_u, nodes, blocks):
                 blocks[count, 3 + i, 3 + j] = -stiffness
         count += 1
     return count
+
+
+@njit(cache=True)
+def element_states(x, cables, stretch, tension):
+    """Each element's stretch and tension [force] (L,) at positions x (n, 3), into the
+    given arrays (the output's fields)."""
+    e = np.empty(3)
+    for k in range(cables.nodes.shape[0]):
+        tension[k], _, stretch[k], _ = _tension(x, cables, k, e)
 
 
 def add_masses(cables: Bundle, mt: np.ndarray, mr: np.ndarray) -> None:

@@ -16,6 +16,7 @@ the solid view, the middle layer's in the shell view.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -26,6 +27,7 @@ from ..mesh import layer_geometry, node_areas
 from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
+from ..loads.cable import element_states
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
@@ -136,6 +138,34 @@ def output_mesh(model: Model, solid: bool = False) -> OutputMesh:
                       node_areas=node_areas(model.x0, model.conn))
 
 
+class CableMesh(NamedTuple):
+    """The cables' view: points (m, 3) their nodes' initial positions, cells (L, 2) their
+    elements over those points, ``nodes`` (m,) the model's node of each point."""
+
+    points: np.ndarray
+    cells: np.ndarray
+    nodes: np.ndarray
+    cell_type: str = "line"
+
+
+def cable_mesh(model: Model) -> CableMesh | None:
+    """The cables of ``model`` as line cells; None without any."""
+    ends = model.loads.cable.nodes
+    if not len(ends):
+        return None
+    nodes, cells = np.unique(ends, return_inverse=True)
+    return CableMesh(points=model.x0[nodes], cells=cells.reshape(ends.shape), nodes=nodes)
+
+
+def cable_fields(sim: Simulation, mesh: CableMesh) -> tuple[dict, dict]:
+    """(point_data, cell_data) of the cables now: ``displacement`` (m, 3) at their nodes,
+    ``stretch`` (current over rest length) and ``tension`` [force] (L,) of each element."""
+    cables = sim.model.loads.cable
+    stretch, tension = np.empty(len(cables.nodes)), np.empty(len(cables.nodes))
+    element_states(sim.state.x, cables, stretch, tension)
+    return {"displacement": sim.state.x[mesh.nodes] - mesh.points}, {"stretch": stretch, "tension": tension}
+
+
 def von_mises(sigma: np.ndarray) -> np.ndarray:
     """sqrt(3/2 s:s), s the deviator of each (..., 3, 3) stress."""
     deviator = sigma - np.trace(sigma, axis1=-2, axis2=-1)[..., None, None] * np.eye(3) / 3.0
@@ -188,8 +218,8 @@ def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.nda
     at_nodes = np.einsum("aq,eq...->ea...", mesh.gauss_to_nodes, cell_values)
     total = np.zeros((model.n_nodes, *cell_values.shape[2:]))
     np.add.at(total, model.conn, at_nodes)
-    count = mesh.elements_at_node.reshape(-1, *([1] * (total.ndim - 1)))
-    return _at_corners(total / count, model.conn, 1)
+    count = np.maximum(mesh.elements_at_node, 1)  # a cable's own node is on no element
+    return _at_corners(total / count.reshape(-1, *([1] * (total.ndim - 1))), model.conn, 1)
 
 
 def _columns(values: np.ndarray) -> np.ndarray:

@@ -19,21 +19,24 @@ import numpy as np
 from ..deck.schema import Output
 from ..errors import OutputError
 from ..solver.run import Listener, Run
-from .fields import OutputMesh, frame_fields, output_mesh
+from .fields import OutputMesh, cable_fields, cable_mesh, frame_fields, output_mesh
 from .folder import write_atomically
 from .mirror import mirrored_mesh, mirrored_values, mirrors, symmetry_planes
 
 XDMF_NAME, PVD_NAME, FRAMES_DIR = "results.xdmf", "results.pvd", "frames"
+#: The cables' own series (line cells), beside the shells' (:func:`shellsim.output.fields.cable_mesh`).
+CABLES = "cables"
 
 
 class XdmfSeries:
-    """``results.xdmf`` + ``results.h5`` in ``folder``, on ``mesh``."""
+    """``<name>.xdmf`` + ``<name>.h5`` in ``folder``, on ``mesh`` (its points, cells and
+    cell type)."""
 
-    def __init__(self, folder: Path, mesh: OutputMesh):
+    def __init__(self, folder: Path, mesh: OutputMesh, name: str = "results"):
         import h5py
         from meshio.xdmf import TimeSeriesWriter
 
-        self.path = folder / XDMF_NAME
+        self.path = folder / f"{name}.xdmf"
         self._writer = TimeSeriesWriter(self.path)
         self._writer.h5_filename = str(self.path.with_suffix(".h5"))  # referenced by its base name
         self._writer.h5_file = h5py.File(self._writer.h5_filename, "w")
@@ -49,11 +52,13 @@ class XdmfSeries:
 
 
 class VtuSeries:
-    """``results.pvd`` indexing one ``frames/results_NNNN.vtu`` per frame, in ``folder``."""
+    """``<name>.pvd`` indexing one ``<frames>/<name>_NNNN.vtu`` per frame, in ``folder``
+    (frames: ``frames`` for the results, ``<name>_frames`` for another series)."""
 
-    def __init__(self, folder: Path, mesh: OutputMesh):
-        self.path = folder / PVD_NAME
-        self.frames = folder / FRAMES_DIR
+    def __init__(self, folder: Path, mesh: OutputMesh, name: str = "results"):
+        self.name = name
+        self.path = folder / f"{name}.pvd"
+        self.frames = folder / (FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}")
         if self.frames.exists():  # frames of an earlier run would be listed by nobody
             shutil.rmtree(self.frames)
         self.frames.mkdir()
@@ -63,7 +68,7 @@ class VtuSeries:
     def write(self, t: float, point_data: dict, cell_data: dict) -> None:
         import meshio
 
-        name = f"{FRAMES_DIR}/results_{len(self.entries):04d}.vtu"
+        name = f"{self.frames.name}/{self.name}_{len(self.entries):04d}.vtu"
         meshio.write(self.path.parent / name, meshio.Mesh(
             self.mesh.points, [(self.mesh.cell_type, self.mesh.cells)], point_data=point_data,
             cell_data={key: [values] for key, values in cell_data.items()}), file_format="vtu")
@@ -90,10 +95,13 @@ class FrameWriter(Listener):
         self.copies = mirrors(symmetry_planes(run.deck, run.mesh) if output.mirror else [])
         self.mesh = mirrored_mesh(self.part, self.copies)
         self.run = run
-        self.series = []
+        self.cables = cable_mesh(run.model)
+        self.series, self.cable_series = [], []
         try:
             for kind in dict.fromkeys(output.formats):
                 self.series.append(SERIES[kind](folder, self.mesh))
+                if self.cables is not None:
+                    self.cable_series.append(SERIES[kind](folder, self.cables, CABLES))
         except OSError as error:
             self.close()
             raise OutputError(f"cannot write the {kind} series in '{folder}': {error.strerror or error}") from None
@@ -114,15 +122,18 @@ class FrameWriter(Listener):
     def on_frame(self, run: Run) -> None:
         point_data, cell_data = self._fields(run)
         t = float(run.sim.state.t)  # a numpy scalar would be written as its repr
-        for series in self.series:
+        written = [(series, point_data, cell_data) for series in self.series]
+        if self.cable_series:
+            written += [(series, *cable_fields(run.sim, self.cables)) for series in self.cable_series]
+        for series, point_values, cell_values in written:
             try:
-                series.write(t, point_data, cell_data)
+                series.write(t, point_values, cell_values)
             except OSError as error:
                 raise OutputError(f"writing the frame at t = {t:.6g} to {series.path} failed: "
                                   f"{error.strerror or error}") from None
 
     def close(self) -> None:
-        for series in self.series:
+        for series in self.series + self.cable_series:
             series.close()
 
 

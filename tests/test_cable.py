@@ -250,3 +250,34 @@ def test_the_cables_series_carries_their_tension_and_motion(tmp_path):
         moved = point_data["displacement"]
         assert np.abs(moved[np.argmax(points[:, 0])]).max() == 0.0  # the held tip
         assert moved[:, 2].min() < -0.29  # the sag, about 0.298
+
+
+def test_renders_draw_the_cables(tmp_path):
+    """A field render of a run with cables draws them in their colour where they hang
+    (pixels of CABLE_COLOUR below the plate, none once the cables' series is gone), and
+    the mesh picture draws them too."""
+    import imageio.v3 as iio
+
+    from shellsim.deck import load_deck
+    from shellsim.execute import run_scene
+    from shellsim.geometry import build_mesh
+    from shellsim.output.render import CABLE_COLOUR, render_field, render_mesh
+
+    source = tmp_path / "hanging.toml"
+    source.write_text(hanging_cable_deck(8).replace("end_time = 6.0", "end_time = 1.0"))
+    out = tmp_path / "out"
+    out.mkdir()
+    run_scene(load_deck(source), source, out)
+    colour = np.array([int(CABLE_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
+
+    def cable_pixels(picture) -> int:
+        return int(np.all(np.abs(iio.imread(picture)[..., :3].astype(int) - colour) <= 8, axis=-1).sum())
+
+    with_cables = render_field(out, "displacement", view="front")[0]
+    drawn = cable_pixels(with_cables)
+    for name in ("cables.xdmf", "cables.h5"):
+        (out / name).unlink()
+    without = render_field(out, "displacement", view="front", out_dir=tmp_path / "bare")[0]
+    assert drawn > 100 and cable_pixels(without) == 0
+    render_mesh(build_mesh(load_deck(source)), tmp_path / "mesh.png")
+    assert cable_pixels(tmp_path / "mesh.png") > 100

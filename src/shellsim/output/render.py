@@ -17,6 +17,8 @@ from ..mesh import Mesh
 
 #: Points drawn along each element edge so curved edges look curved.
 EDGE_SAMPLES = 9
+#: The colour cables are drawn in, over any field.
+CABLE_COLOUR = "#7b3f00"
 SET_COLOURS = ["#e41a1c", "#377eb8", "#4daf4a", "#984ea3", "#ff7f00", "#a65628", "#f781bf",
                "#999999", "#66c2a5", "#fc8d62", "#8da0cb", "#e78ac3"]
 
@@ -73,8 +75,8 @@ def _look(plotter: Any, view: str, x: np.ndarray) -> None:
 
 
 def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> None:
-    """PNG of the mesh: surface, element edges, and every edge and point set in its own
-    colour with a legend. Flat meshes are seen from above, others isometrically."""
+    """PNG of the mesh: surface, element edges, cables, and every edge, line and point set
+    in its own colour with a legend. Flat meshes are seen from above, others isometrically."""
     pv = _pyvista()
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
@@ -82,6 +84,9 @@ def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> 
     actor = plotter.add_mesh(surface, color="#d9d9d9", smooth_shading=True)
     actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # edges drawn on top of the face
     plotter.add_mesh(element_outlines(mesh.x, mesh.conn), color="black", line_width=3)
+    if len(mesh.lines):
+        segments = np.column_stack([np.full(len(mesh.lines), 2), mesh.lines]).ravel()
+        plotter.add_mesh(pv.PolyData(mesh.x, lines=segments), color=CABLE_COLOUR, line_width=3)
     extent = np.ptp(mesh.x, axis=0)
     scale = float(np.linalg.norm(extent)) or 1.0
     legend = []
@@ -162,10 +167,13 @@ class Overlays(NamedTuple):
 
 class Drawn(NamedTuple):
     """The overlays' data for one frame: the initial points (P, 3) whose element outlines
-    are drawn, or None, and each fibre family's cell vectors (C, 3)."""
+    are drawn, or None, each fibre family's cell vectors (C, 3), and the cables: their
+    points now (m, 3) and lines (L, 2), or None."""
 
     initial: np.ndarray | None = None
     fibres: tuple[np.ndarray, ...] = ()
+    cables: tuple[np.ndarray, np.ndarray] | None = None
+
 
 
 NO_OVERLAYS = Overlays()
@@ -179,9 +187,11 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     to ``out_dir`` (default ``folder/renders``), with the ``overlays``. Returns the files
     written."""
     from .fields import FIBRE_PREFIX, NODAL_SUFFIX, labelled
-    from .series import StoredSeries
+    from .series import CABLES, StoredSeries
 
     series = StoredSeries(folder)
+    cables = StoredSeries(folder, CABLES) if (folder / f"{CABLES}.xdmf").exists() or (
+        folder / f"{CABLES}.pvd").exists() else None
     indices = _frame_indices(frame, len(series.times))
     frames = [series.frame(i) for i in indices]
     picked = [field_values(p, c, field, component) for p, c in frames]
@@ -206,9 +216,12 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         path = out_dir / f"{stem}_{index:04d}.png"
         deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
         fibres = tuple(v for name, v in sorted(cell_data.items()) if overlays.fibres and name.startswith(FIBRE_PREFIX))
+        chords = None
+        if cables is not None:  # written with the shells' frames, frame for frame
+            chords = (cables.points + np.asarray(cables.frame(index)[0]["displacement"]), cables.cells)
         _render_frame(deformed, series, Colouring(values, on_cells, bar, (low, high)), view, size,
                       f"{title}\nt = {series.times[index]:.6g}", path,
-                      Drawn(series.points if overlays.outline else None, fibres))
+                      Drawn(series.points if overlays.outline else None, fibres, chords))
         written.append(path)
     if frame == "all":
         import imageio.v3 as iio
@@ -236,8 +249,8 @@ FIBRE_COLOURS = ["black", "white", "magenta"]
 def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, size: tuple[int, int], caption: str,
                   path: Path, drawn: Drawn) -> None:
     """One PNG: the sub-cells at ``points`` coloured by ``colouring``, element outlines on
-    top; the ``drawn`` overlays: the initial shape's outlines in grey, and each fibre
-    family as lines through the elements' centres."""
+    top; the ``drawn`` overlays: the initial shape's outlines in grey, each fibre family as
+    lines through the elements' centres, and the cables."""
     values, on_cells, bar, limits = colouring
     pv = _pyvista()
     cell_type = pv.CellType.HEXAHEDRON if series.cell_type == "hexahedron" else pv.CellType.QUAD
@@ -271,6 +284,11 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
             ends = np.concatenate([centres - length * directions, centres + length * directions])
             plotter.add_mesh(pv.PolyData(ends, lines=segments), color=FIBRE_COLOURS[family % len(FIBRE_COLOURS)],
                              line_width=2)
+    if drawn.cables is not None:
+        at, ends = drawn.cables
+        segments = np.column_stack([np.full(len(ends), 2), ends]).ravel()
+        plotter.add_mesh(pv.PolyData(at, lines=segments), color=CABLE_COLOUR, line_width=3)
+        points = np.vstack([points, at])  # the view takes them in
     plotter.add_text(caption, position="upper_left", font_size=max(8, size[1] // 70), color="black")
     _look(plotter, view, points)
     try:

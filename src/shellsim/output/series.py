@@ -147,21 +147,23 @@ def check_space(folder: Path, needed: int) -> None:
 
 
 class StoredSeries:
-    """A written series read back: ``points`` (P, 3), ``cells`` (C, k) of ``cell_type``,
-    ``times`` of the frames; :meth:`frame` gives one frame's (point_data, cell_data)."""
+    """A written series read back (the shells' ``results``, or the ``cables``): ``points``
+    (P, 3), ``cells`` (C, k) of ``cell_type``, ``times`` of the frames; :meth:`frame` gives
+    one frame's (point_data, cell_data)."""
 
-    def __init__(self, folder: Path):
+    def __init__(self, folder: Path, name: str = "results"):
         import meshio
 
         self.folder = folder
-        if (folder / XDMF_NAME).exists():
-            self._reader = meshio.xdmf.TimeSeriesReader(folder / XDMF_NAME)
+        xdmf, pvd = folder / f"{name}.xdmf", folder / f"{name}.pvd"
+        if xdmf.exists():
+            self._reader = meshio.xdmf.TimeSeriesReader(xdmf)
             points, cells = self._reader.read_points_cells()
             # the times from the XML alone: reading each frame's data here would read it twice
-            self.times = [float(t.get("Value")) for t in ET.parse(folder / XDMF_NAME).getroot().iter("Time")]
-        elif (folder / PVD_NAME).exists():
+            self.times = [float(t.get("Value")) for t in ET.parse(xdmf).getroot().iter("Time")]
+        elif pvd.exists():
             self._reader = None
-            index = ET.parse(folder / PVD_NAME).getroot().iter("DataSet")
+            index = ET.parse(pvd).getroot().iter("DataSet")
             self._files = [(float(item.get("timestep")), item.get("file")) for item in index]
             self.times = [t for t, _ in self._files]
             first = meshio.read(folder / self._files[0][1]) if self._files else None

@@ -19,7 +19,7 @@ from .errors import MeshError
 from .element.frames import initial_fibre_frame
 from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
-from .loads import LoadScene, build_loads
+from .loads import DECK_KEYS, LoadScene, build_loads
 from .materials.laws import law_of
 from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh, inverse_jacobians, layer_geometry
@@ -86,7 +86,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     constraints, e1f0 = _boundary_conditions(deck, mesh)
     curves = _curve_tables(deck)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
-    loads = build_loads({"load": deck.load, "contact": deck.contact, "cable": deck.cable},
+    loads = build_loads({key: getattr(deck, key) for key in DECK_KEYS},
                         LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
                                   curve_index=deck.curve_index))
     return Model(

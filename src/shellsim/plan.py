@@ -8,6 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from .deck import Deck
+from .loads import DECK_KEYS
 from .loads import features as load_features
 
 
@@ -36,7 +37,7 @@ def plan(deck: Deck) -> Plan:
         "anisotropic": deck.material.ANISOTROPIC,
         "thickness_update": deck.thickness_update,
         "plane_strain": deck.section.plane_strain,
-        **load_features(deck.load + deck.contact + deck.cable),
+        **load_features([table for key in DECK_KEYS for table in getattr(deck, key)]),
         "prescribed_motion": any(bc.type == "prescribed" for bc in deck.boundary),
         "damping": deck.solver.damping > 0.0,
     })

@@ -81,7 +81,8 @@ def read_mesh(path: Path) -> ImportedMesh:
                     if block.type == "line" and np.any(np.asarray(m.cell_data.get(CABLE_MARK, [[]] * len(m.cells))[i]))]
     lines_raw = np.concatenate([np.zeros((0, 2), dtype=np.int64)]
                                + [np.asarray(m.cells[i].data, dtype=np.int64) for i in cable_blocks])
-    used = np.concatenate([np.unique(conn_raw), np.setdiff1d(lines_raw, conn_raw)])  # the cables' own nodes last
+    own = np.setdiff1d(lines_raw, conn_raw)  # the cables' nodes that no shell has, kept last
+    used = np.concatenate([np.unique(conn_raw), own])
     index = np.full(len(m.points), -1)
     index[used] = np.arange(len(used))
     x = np.asarray(m.points, dtype=float)[used]
@@ -100,7 +101,7 @@ def read_mesh(path: Path) -> ImportedMesh:
         return values.reshape(len(m.points), width)[used] if width else values.reshape(len(m.points))[used]
 
     director, thickness = point_array("director", 3), point_array("thickness", None)
-    shell = len(used) - len(np.setdiff1d(lines_raw, conn_raw))  # a cable's own node has no thickness to check
+    shell = len(used) - len(own)  # a cable's own node has no thickness to check
     problems = repeated_node_problem(conn_raw) + point_data_problems(
         x[:shell], None if director is None else director[:shell], None if thickness is None else thickness[:shell],
         node_ids=used[:shell] + 1)

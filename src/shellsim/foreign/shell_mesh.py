@@ -96,10 +96,9 @@ class ShellMesh:
         self.x = np.vstack([self.x, np.asarray([positions[label] for label in new], dtype=float).reshape(-1, 3)])
         along = self.x[self.lines[:, 1]] - self.x[self.lines[:, 0]]
         director = np.tile([0.0, 0.0, 1.0], (len(new), 1))
-        owner = self.lines[:, 1] >= self.shell_nodes
-        director[self.lines[owner, 1] - self.shell_nodes] = along[owner]
-        owner = self.lines[:, 0] >= self.shell_nodes
-        director[self.lines[owner, 0] - self.shell_nodes] = along[owner]
+        for end in (1, 0):  # each new node along a line it ends
+            owner = self.lines[:, end] >= self.shell_nodes
+            director[self.lines[owner, end] - self.shell_nodes] = along[owner]
         self.director = np.vstack([self.director, director / np.linalg.norm(director, axis=1, keepdims=True)])
 
     def line_set(self, labels) -> NamedSet | None:

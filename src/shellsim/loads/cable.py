@@ -256,7 +256,8 @@ def critical_step(shape, cables):
     smallest = np.inf
     for k in range(cables.nodes.shape[0]):
         tension, length, stretch, dp = _tension(shape.x, cables, k, e)
-        dp = nominal_stress(cables.law[k], cables.params[k], max(stretch, 1.0))[1]
+        if stretch < 1.0:  # slack: the slope it takes up as soon as it is taut
+            dp = nominal_stress(cables.law[k], cables.params[k], 1.0)[1]
         stiffness = max(cables.area[k] * dp / cables.rest[k], tension / length)
         if stiffness > 0.0:
             mass = cables.density[k] * cables.area[k] * cables.rest[k]

@@ -21,7 +21,10 @@ from shellsim.deck import parse_deck
 from shellsim.geometry import build_mesh
 from shellsim.model import build_model
 from shellsim.solver.simulation import Simulation
+from shellsim.threads import ThreadChooser
 from tests.conftest import deck_text
+
+CHOOSE = sys.argv[2] == "choose"
 
 def run(material, section):
     text = deck_text('builder = "tube"\\ninner_radius = 1.0\\nlength = 1.0',
@@ -31,8 +34,12 @@ def run(material, section):
     text = text.replace("[section]", "[section]\\n" + section).replace("thickness = 0.01", "thickness = 0.1")
     deck = parse_deck(text)
     sim = Simulation(build_model(deck, build_mesh(deck)))
+    if CHOOSE:  # try the other count on every second block of 4 steps
+        sim.threads = ThreadChooser(sim.threads.current, probe_interval=0.0, probe_seconds=0.0, longest_interval=0.0)
     dt = 0.5 * sim.critical_time_step()
-    sim.advance(40 * dt, dt, 40)
+    while sim.state.steps < 40:
+        sim.advance(40 * dt, dt, 40 - sim.state.steps)
+    assert sim.state.steps == 40
     s = sim.state
     return [s.x, s.d, s.h, s.stress, s.f_int, s.fr_int]
 
@@ -42,21 +49,25 @@ np.savez(sys.argv[1], *arrays)
 """
 
 
-def _results(threads: int, folder) -> list[np.ndarray]:
-    out = folder / f"threads{threads}.npz"
+def _results(threads: int, folder, choose: bool = False) -> list[np.ndarray]:
+    out = folder / f"threads{threads}{'choose' * choose}.npz"
     env = dict(os.environ, NUMBA_NUM_THREADS=str(threads))
-    subprocess.run([sys.executable, "-c", SCRIPT, str(out)], check=True, env=env, cwd=os.path.dirname(os.path.dirname(__file__)))
+    subprocess.run([sys.executable, "-c", SCRIPT, str(out), "choose" if choose else "fixed"], check=True, env=env,
+                   cwd=os.path.dirname(os.path.dirname(__file__)))
     with np.load(out) as data:
         return [data[name] for name in data.files]
 
 
 @pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="needs two cores to run two threads")
 def test_one_and_two_threads_give_identical_bits(tmp_path):
-    one, two = _results(1, tmp_path), _results(2, tmp_path)
-    assert len(one) == len(two) == 12
-    for a, b in zip(one, two):
+    """Also when the thread chooser moves the steps between one and two threads every
+    few steps (:mod:`shellsim.threads`)."""
+    one, two, moving = _results(1, tmp_path), _results(2, tmp_path), _results(2, tmp_path, choose=True)
+    assert len(one) == len(two) == len(moving) == 12
+    for a, b, c in zip(one, two, moving):
         assert np.abs(a).max() > 0.0
         np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
 
 
 def test_kernels_compile_at_llvm_level_1_unless_told_and_each_level_has_its_own_cache():
@@ -70,3 +81,15 @@ def test_kernels_compile_at_llvm_level_1_unless_told_and_each_level_has_its_own_
                           check=True)
     (level, folder), (told_level, told_folder) = default.stdout.split(), told.stdout.split()
     assert (level, told_level) == ("1", "3") and folder != told_folder
+
+
+def test_numba_imported_before_shellsim_still_uses_its_cache_folder_and_level():
+    """A script that imports numba first had numba read its settings before shellsim set
+    them: its kernels compiled at level 3 into the source tree's __pycache__, where numba
+    checks each function against its own file only (stale element code in a cached loop)."""
+    probe = ("import numba, shellsim, os; from shellsim.element import response; "
+             "print(int(numba.config.OPT), response.group_response._cache._cache_path, os.environ['NUMBA_CACHE_DIR'])")
+    env = {k: v for k, v in os.environ.items() if k not in ("NUMBA_OPT", "NUMBA_CACHE_DIR")}
+    level, path, folder = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True,
+                                         check=True).stdout.split()
+    assert level == "1" and path.startswith(folder) and "__pycache__" not in path

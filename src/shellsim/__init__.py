@@ -3,6 +3,7 @@ continuum-based shell element."""
 
 import hashlib
 import os
+import sys
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -29,6 +30,8 @@ def _numba_cache_dir() -> str:
 
 # LLVM's level 1 compiles the kernels a fifth faster than numba's default 3 and runs them as
 # fast, to the same bits (no fast-math is used; docs/verification.md, "Optimisation level").
-# Read by numba when it is first imported: after shellsim, as here.
+# Read by numba when it is first imported, or again here when it was imported before shellsim.
 os.environ.setdefault("NUMBA_OPT", "1")
 os.environ.setdefault("NUMBA_CACHE_DIR", _numba_cache_dir())
+if "numba" in sys.modules:  # imported first, it has read its settings: read them again
+    sys.modules["numba"].core.config.reload_config()

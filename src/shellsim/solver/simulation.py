@@ -3,6 +3,7 @@ in time. Holds arrays only; the time loop itself is compiled (:mod:`.explicit`).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -17,6 +18,7 @@ from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..loads import add_masses
 from ..model import Model
+from ..threads import ThreadChooser, kernel_threads, limit_to_usable_cpus
 from . import explicit
 from .timestep import critical_time_step
 
@@ -64,6 +66,7 @@ class Simulation:
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
                                  stiffness=TypedCall(stiffness_product))
         self._eigenvector: np.ndarray | None = None
+        self.threads = ThreadChooser(limit_to_usable_cpus())
         self.update_masses()
         self.evaluate_forces()
 
@@ -110,14 +113,18 @@ class Simulation:
 
     def advance(self, t_stop: float, dt: float, max_steps: int) -> int:
         """Step with ``dt`` until ``t_stop`` (landing on it) or ``max_steps``; returns the
-        number of steps taken."""
+        number of steps taken (fewer when the thread chooser tries a count on a few)."""
         s = self.state
+        count, max_steps = self.threads.plan(max_steps)
+        start = time.perf_counter()
         try:
-            s.t, s.dt_prev, steps = self._advance(t_stop, dt, max_steps)
+            with kernel_threads(count):
+                s.t, s.dt_prev, steps = self._advance(t_stop, dt, max_steps)
         except (ZeroDivisionError, FloatingPointError) as error:
             # a director or frame collapsed: the state has degenerated beyond recovery
             raise NumericalError(f"the run broke down at t = {s.t:.6g} after {s.steps} steps: "
                                  f"a degenerate state ({error}); the motion had become unstable") from None
+        self.threads.record(count, steps, time.perf_counter() - start)
         s.steps += steps
         return steps
 

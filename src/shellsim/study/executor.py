@@ -10,12 +10,12 @@ worker threads; see :mod:`shellsim.geometry.session`).
 
 from __future__ import annotations
 
-import os
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from ..errors import StudyError
+from ..threads import usable_cpus
 from .jobs import Job, failed_row, run_job
 
 WARM_UP_DECK = """
@@ -84,7 +84,7 @@ CONNECT_TIMEOUT = 5.0
 
 def open_client(scheduler: str | None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
     """A dask client on ``scheduler`` (tcp://host:port), or on a new local cluster of
-    ``workers`` single-threaded processes (default: one per core). Raises StudyError when
+    ``workers`` single-threaded processes (default: one per CPU this process may use). Raises StudyError when
     the scheduler does not answer within ``timeout`` seconds.
 
     On the local cluster a job whose worker dies is not given to another worker (dask's
@@ -102,7 +102,7 @@ def open_client(scheduler: str | None, workers: int | None = None, timeout: floa
                              "tcp://HOST:PORT?") from None
     # the client owns this cluster and shuts it down when closed
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        return Client(n_workers=workers or os.cpu_count() or 1, threads_per_worker=1, processes=True,
+        return Client(n_workers=workers or usable_cpus(), threads_per_worker=1, processes=True,
                       dashboard_address=None)
 
 

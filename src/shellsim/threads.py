@@ -1,0 +1,131 @@
+"""How many threads the kernels run on.
+
+At most the CPUs this process may use: its affinity mask and its cgroup's CPU quota (a
+container or a batch job given 2 of a node's 64 cores), not the machine's count that numba
+starts from. Within that, a run's steps use whichever of one thread or all of them is
+faster now (:class:`ThreadChooser`): on a machine other work keeps busy, the threads of a
+parallel loop wait at its end for the one the scheduler took away, and two threads ran 7x
+slower than one. The results do not depend on the count (:mod:`shellsim.element.assembly`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import statistics
+import time
+from collections import deque
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+#: Where a cgroup v2 and a cgroup v1 keep the CPU quota (microseconds per period).
+CGROUP_V2_MAX = Path("/sys/fs/cgroup/cpu.max")
+CGROUP_V1 = Path("/sys/fs/cgroup/cpu")
+
+
+def cgroup_cpus(v2_max: Path = CGROUP_V2_MAX, v1: Path = CGROUP_V1) -> float | None:
+    """The CPUs the cgroup's quota grants (quota / period), or None without a quota."""
+    try:
+        quota, period = v2_max.read_text().split()[:2]
+        return None if quota == "max" else int(quota) / int(period)
+    except (OSError, ValueError):
+        pass
+    try:
+        quota = int((v1 / "cpu.cfs_quota_us").read_text())
+        period = int((v1 / "cpu.cfs_period_us").read_text())
+    except (OSError, ValueError):
+        return None
+    return quota / period if quota > 0 and period > 0 else None
+
+
+def usable_cpus() -> int:
+    """The CPUs this process may use: its affinity, within its cgroup's quota (at least 1)."""
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:  # no affinity on this platform
+        cpus = os.cpu_count() or 1
+    quota = cgroup_cpus()
+    if quota is not None:
+        cpus = min(cpus, math.ceil(quota))
+    return max(1, cpus)
+
+
+def limit_to_usable_cpus() -> int:
+    """Keep the calling thread's kernels within the usable CPUs (numba starts from the
+    machine's count, or NUMBA_NUM_THREADS when the user set it); returns the count."""
+    import numba
+
+    count = max(1, min(numba.get_num_threads(), usable_cpus()))
+    numba.set_num_threads(count)
+    return count
+
+
+@contextmanager
+def kernel_threads(count: int) -> Iterator[None]:
+    """The calling thread's kernels run on ``count`` threads inside the block."""
+    import numba
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(count)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
+
+
+class ThreadChooser:
+    """Chooses, block by block of steps, between one thread and ``most``: it runs at its
+    current count and, every ``probe_interval`` seconds, tries the other count on a block
+    of about ``probe_seconds`` at the current pace, switching when that block went faster
+    per step than the current count's recent blocks. A probe that loses waits twice as
+    long before the next, up to ``longest_interval``: where the other count is 7x slower
+    the probes cost about 1% of the run, and a change of load is followed within that
+    interval.
+
+    Use: ``count, steps = chooser.plan(max_steps)``, run at most ``steps`` steps on
+    ``count`` threads, then ``chooser.record(count, steps_taken, seconds)``. With
+    ``choose`` False it always answers ``most`` (a measurement of that count)."""
+
+    def __init__(self, most: int, choose: bool = True, probe_interval: float = 1.0, probe_seconds: float = 0.01,
+                 longest_interval: float = 8.0, clock: Callable[[], float] = time.perf_counter):
+        self.counts = (most, 1) if choose and most > 1 else (most,)
+        self.current = most
+        self.probe_interval = probe_interval
+        self.probe_seconds = probe_seconds
+        self.longest_interval = longest_interval
+        self.clock = clock
+        self._interval = probe_interval
+        self._next_probe: float | None = None  # set after the first block (which may compile)
+        self._recent: deque[float] = deque(maxlen=5)  # seconds per step at the current count
+
+    @property
+    def other(self) -> int:
+        """The count a probe tries."""
+        return self.counts[1] if self.current == self.counts[0] else self.counts[0]
+
+    def plan(self, max_steps: int) -> tuple[int, int]:
+        """(threads, steps) for the next block of at most ``max_steps`` steps: the current
+        count, or a probe of the other count on a few steps."""
+        if len(self.counts) == 1 or not self._recent or self.clock() < self._next_probe:
+            return self.current, max_steps
+        steps = max(4, int(self.probe_seconds / statistics.median(self._recent)))
+        return self.other, min(max_steps, steps)
+
+    def record(self, count: int, steps: int, seconds: float) -> None:
+        """A block of ``steps`` steps took ``seconds`` on ``count`` threads."""
+        if steps <= 0 or len(self.counts) == 1:
+            return
+        pace = seconds / steps
+        if self._next_probe is None:  # the first block may hold the kernels' compilation
+            self._next_probe = self.clock() + self._interval
+        elif count == self.current:
+            self._recent.append(pace)
+        else:
+            if self._recent and pace < statistics.median(self._recent):
+                self.current = count
+                self._recent = deque([pace], maxlen=5)
+                self._interval = self.probe_interval
+            else:
+                self._interval = min(2.0 * self._interval, self.longest_interval)
+            self._next_probe = self.clock() + self._interval

@@ -65,7 +65,9 @@ def element_tangents(rule, body, material, shape, converged, differences, k):
     step_u, step_r = differences
     path = steps_of(material, np.bool_(False))
     for e in prange(ne):
-        _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, k[e])
+        # e as int64: the parallel loop's own index is unsigned, and typed so it would
+        # compile _element_tangent a second time
+        _element_tangent(np.int64(e), path, rule, body, material, shape, dx, dd, stress, step_u, step_r, k[e])
 
 
 @njit(cache=True, error_model="numpy")
@@ -102,7 +104,9 @@ def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_
                         (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
         if path.incremental:
             group.stress[:] = base_stress
-        group_response(path, rule, material, group, points, scratch, LANES)
+        # every lane; counted at run time, as the element loop counts, so that one compiled
+        # group_response serves both (the literal LANES would compile a second)
+        group_response(path, rule, material, group, points, scratch, members.shape[0])
         for lane in range(LANES):
             move = min(batch * LANES + lane, _MOVES - 1)
             if batch * LANES + lane < _MOVES:

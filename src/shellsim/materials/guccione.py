@@ -54,7 +54,7 @@ def fibres(params) -> np.ndarray:
     return np.array([[1.0, 0.0]])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _weight(params, i, j):
     """b_ij: C2 along the fibre (11), C4 for the fibre shears (12, 13), C3 for the rest."""
     if i == 0 and j == 0:
@@ -64,7 +64,7 @@ def _weight(params, i, j):
     return params[2]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _exponent(params, E, lane):
     """Q = sum_ij b_ij E_ij^2 of lane ``lane`` of E (3, 3, G)."""
     Q = 0.0
@@ -74,14 +74,14 @@ def _exponent(params, E, lane):
     return Q
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
     for lane in range(LANES):
         W[lane] = 0.5 * params[0] * (np.exp(_exponent(params, E, lane)) - 1.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
     for lane in range(LANES):
@@ -91,7 +91,7 @@ def energy_stress(params, E, S):
                 S[i, j, lane] = scale * _weight(params, i, j) * E[i, j, lane]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE at E, dE (3, 3, G)."""
     for lane in range(LANES):

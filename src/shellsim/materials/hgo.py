@@ -72,7 +72,7 @@ def fibres(params) -> np.ndarray:
     return np.array([[params[4], params[5]], [params[4], -params[5]]])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _structure(params, family, H):
     """H (3, 3) = kappa I + (1 - 3 kappa) a a of fibre family 0 (+beta) or 1 (-beta);
     returns the family's direction a = (a0, a1, 0) as (a0, a1)."""
@@ -88,7 +88,7 @@ def _structure(params, family, H):
     return a0, a1
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _fibre_strain(a0, a1, H, E, lane):
     """(Ebar = 2 H : E, whether the family along (a0, a1, 0) is stretched) of lane ``lane``
     of E (3, 3, G)."""
@@ -100,7 +100,7 @@ def _fibre_strain(a0, a1, H, E, lane):
     return ebar, stretched
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
     mu, k1, k2 = params[0], params[1], params[2]
@@ -115,7 +115,7 @@ def energy(params, E, W):
                 W[lane] += k1 / (2.0 * k2) * (np.exp(k2 * ebar * ebar) - 1.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
     mu, k1, k2 = params[0], params[1], params[2]
@@ -134,7 +134,7 @@ def energy_stress(params, E, S):
                         S[i, j, lane] += 2.0 * psi * H[i, j]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE at E, dE (3, 3, G)."""
     k1, k2 = params[1], params[2]

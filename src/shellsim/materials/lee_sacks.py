@@ -66,7 +66,7 @@ def fibres(params) -> np.ndarray:
     return np.array([[params[5], params[6]]])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _invariants(params, E, lane):
     """(tr E, a.E a) of lane ``lane`` of E (3, 3, G)."""
     c, s = params[5], params[6]
@@ -75,7 +75,7 @@ def _invariants(params, E, lane):
     return trace, fibre
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _add_fibre(params, factor, T, lane):
     """T[:, :, lane] += factor a a."""
     c, s = params[5], params[6]
@@ -85,7 +85,7 @@ def _add_fibre(params, factor, T, lane):
     T[1, 0, lane] += factor * c * s
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
     c0, c1, c2, c3, delta = params[0], params[1], params[2], params[3], params[4]
@@ -96,7 +96,7 @@ def energy(params, E, W):
             W[lane] += 0.5 * c1 * (1.0 - delta) * (np.exp(4.0 * c3 * fibre * fibre) - 1.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
     c0, c1, c2, c3, delta = params[0], params[1], params[2], params[3], params[4]
@@ -110,7 +110,7 @@ def energy_stress(params, E, S):
             _add_fibre(params, 4.0 * c1 * (1.0 - delta) * c3 * fibre * np.exp(4.0 * c3 * fibre * fibre), S, lane)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE at E, dE (3, 3, G)."""
     c1, c2, c3, delta = params[1], params[2], params[3], params[4]

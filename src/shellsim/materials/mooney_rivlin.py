@@ -59,7 +59,7 @@ def parameters(material) -> np.ndarray:
     return np.array([material.C1, getattr(material, "C2", 0.0)])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
     C1, C2 = params[0], params[1]
@@ -73,7 +73,7 @@ def energy(params, E, W):
         W[lane] = C1 * (I1 - 3.0) + C2 * (0.5 * (I1 * I1 - trC2) - 3.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
     C1, C2 = params[0], params[1]
@@ -87,7 +87,7 @@ def energy_stress(params, E, S):
             S[i, i, lane] += 2.0 * (C1 + C2 * I1)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE at E, dE (3, 3, G)."""
     C2 = params[1]

@@ -31,13 +31,13 @@ def parameters(material) -> np.ndarray:
     return np.array([lam, material.E / (2 * (1 + material.nu)), SHEAR_FACTOR])
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _shear(params, i, j):
     """k_ij: kappa for the transverse shears (one index 3, the other not), else 1."""
     return params[2] if (i == 2) != (j == 2) else 1.0
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
     lam, mu = params[0], params[1]
@@ -49,7 +49,7 @@ def energy(params, E, W):
                 W[lane] += mu * _shear(params, i, j) * E[i, j, lane] * E[i, j, lane]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
     lam, mu = params[0], params[1]
@@ -61,7 +61,7 @@ def energy_stress(params, E, S):
             S[i, i, lane] += lam * trace
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE, the stress of dE (3, 3, G) (the law is linear)."""
     energy_stress(params, dE, dS)

@@ -45,9 +45,18 @@ def pytest_configure(config):
     workers compiling the same kernels into one cache at once have crashed (the pitfall
     the study executor avoids the same way)."""
     if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
+        import time
+
+        from shellsim.compile_watch import FIRST_RUN_NOTE, watching_compiles
         from shellsim.study.executor import warm_numba_cache
 
-        warm_numba_cache()
+        start = time.perf_counter()
+        compiled = []
+        with watching_compiles(lambda name: compiled or print(f"compiling the kernels ({FIRST_RUN_NOTE})", flush=True),
+                               lambda name, seconds: compiled.append(name)):
+            warm_numba_cache()
+        if compiled:
+            print(f"compiled {len(compiled)} kernels in {time.perf_counter() - start:.0f} s", flush=True)
 
 
 def prepared(deck, base_dir: Path | None = None):

@@ -13,6 +13,7 @@ import sys
 import tempfile
 import time
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 import numba
@@ -27,6 +28,7 @@ from .output.mesh_files import write_mesh_vtu
 from .execute import built_run
 from .solver.run import integrate
 from .solver.simulation import Simulation
+from .threads import ThreadChooser
 from .verify.check import check
 
 DECKS = Path(__file__).resolve().parents[2] / "decks"
@@ -85,18 +87,22 @@ def scordelis_lo(divisions: int, material: dict | None = None, section: dict | N
     return Simulation(build_model(deck, build_mesh(deck)))
 
 
-def path_speeds(divisions: int = 16, steps: int = 100, threads: tuple[int, ...] | None = None) -> list[dict]:
+def path_speeds(divisions: int = 16, steps: int = 100, threads: tuple[int, ...] | None = None,
+                on_path: Callable[[str, int], None] = lambda label, count: None) -> list[dict]:
     """Microseconds per element per step of the full time step (forces, update) for each
     constitutive path of :data:`PATHS` on the Scordelis-Lo roof, on each number of
     ``threads`` (default: one, and every core numba may use), each from rest at the
     critical step over 1.25. GFLOP/s where the operation count is known (the small-strain
-    path, :func:`flops_per_element`)."""
+    path, :func:`flops_per_element`). ``on_path(label, threads)`` hears of each path as it
+    starts."""
     threads = threads or tuple(sorted({1, numba.config.NUMBA_NUM_THREADS}))
     rows = []
     for label, material, section in PATHS:
         for count in threads:
+            on_path(label, count)
             numba.set_num_threads(count)
             sim = scordelis_lo(divisions, material, section)
+            sim.threads = ThreadChooser(count, choose=False)
             us = _us_per_element_step(sim, steps, 1.25)
             row = {"path": label, "threads": count, "elements": sim.model.n_elements, "steps": steps,
                    "us_per_element_step": us}

@@ -103,12 +103,12 @@ def check(deck: DeckPath) -> None:
     scene = load_deck(deck)
     mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{escape(text)}[/]", highlight=False))
     static = scene.solver.method == "static"
-    with err.status("building the model") as status:
+    with err.status("building the model") as status, _compiles_shown(status):
         model = build_model(scene, mesh)
         if static:
             outlook = static_outlook(model)
         else:
-            status.update("estimating the critical time step (the first use compiles the kernels, about two minutes)")
+            status.update("estimating the critical time step")
             outlook = step_outlook(scene, model, lambda count: status.update(
                 f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
@@ -126,6 +126,25 @@ def check(deck: DeckPath) -> None:
             "puts the time step above the critical step: the run will be unstable"
         )
     out.print(f"[green]ok[/] {deck}")
+
+
+def _compiles_shown(status):
+    """The kernels compiling inside the block shown on ``status`` (a rich status line), and
+    those that took a while printed when done; the status line returns to what it said."""
+    from .compile_watch import FIRST_RUN_NOTE, watching_compiles
+
+    said = []
+
+    def start(name: str) -> None:
+        said.append(status.status)
+        status.update(f"compiling {name} ({FIRST_RUN_NOTE})")
+
+    def end(name: str, seconds: float) -> None:
+        status.update(said.pop())
+        if seconds >= 5.0:
+            err.print(f"[dim]compiled {name} in {seconds:.0f} s[/]", highlight=False)
+
+    return watching_compiles(start, end)
 
 
 @app.command()
@@ -213,13 +232,15 @@ def run(
     and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
     reference check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM
     (what was written stays readable; the summary says interrupted)."""
+    from .compile_watch import watching_compiles
     from .deck import load_deck
     from .execute import run_scene
     from .output.progress import ProgressDisplay
 
     scene = load_deck(deck)
     folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
-    with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress:
+    with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress, \
+            watching_compiles(progress.compiling, progress.compiled):
         current, result = run_scene(scene, deck, folder, progress, progress.announce)
     message = result["message"]
     if current.status == "interrupted":
@@ -325,8 +346,11 @@ def render(
     if unknown:
         raise typer.BadParameter(f"cannot show {', '.join(sorted(unknown))}; expected {', '.join(Overlays._fields)}",
                                  param_hint="--show")
-    _announce(render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir,
-                           Overlays(**{name: True for name in show or []})))
+    with err.status(f"rendering {field}") as status:
+        written = render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir,
+                               Overlays(**{name: True for name in show or []}),
+                               lambda done, total: status.update(f"rendering {field}: {done} of {total} frames"))
+    _announce(written)
 
 
 @app.command()
@@ -349,7 +373,7 @@ def report(
     out_dir: Annotated[Path | None, typer.Option("--out", help="Report folder [default: results/STUDY-NAME].")] = None,
     scheduler: Annotated[str | None, typer.Option(help="A running dask scheduler, tcp://HOST:PORT "
                                                        "[default: a local cluster].")] = None,
-    workers: Annotated[int | None, typer.Option(min=1, help="Workers of the local cluster [default: one per core].")] = None,
+    workers: Annotated[int | None, typer.Option(min=1, help="Workers of the local cluster [default: one per usable CPU].")] = None,
     connect_timeout: Annotated[float, typer.Option(min=0.1, help="Seconds to wait for --scheduler to answer.")] = 5.0,
     embed_in: Annotated[Path | None, typer.Option("--embed", help="Also write the table into this markdown file, "
                                                   "between '<!-- report STUDY-NAME -->' and "
@@ -408,15 +432,18 @@ def bench(
     elements, every node touching)."""
     from .bench import contact_cost, dgemm_gflops, path_speeds, plate_ladder
 
-    rows = path_speeds()
-    dgemm = dgemm_gflops()
+    with err.status("bench: the constitutive paths") as status, _compiles_shown(status):
+        rows = path_speeds(on_path=lambda label, count: status.update(f"bench: {label}, {count} thread(s)"))
+        status.update("bench: a matrix product on one thread")
+        dgemm = dgemm_gflops()
     out.print(_paths_table(rows))
     for row in rows:
         if "gflops" in row:
             out.print(f"{row['path']}, {row['threads']} thread(s): {row['flops_per_element_step']:,} flop per "
                       f"element-step, {row['gflops']:.2f} GFLOP/s = {100 * row['gflops'] / (dgemm * row['threads']):.1f}% "
                       f"of a one-thread matrix product's {dgemm:.1f} GFLOP/s per thread")
-    ladder = plate_ladder()
+    with err.status("bench: the bench plate at 2 x 2, 4 x 4 and 8 x 8") as status, _compiles_shown(status):
+        ladder = plate_ladder()
     table = Table(title="bench plate (decks/bench/plate_step.toml): first peak", title_justify="left")
     for column in ("mesh", "elements", "steps", "start-up: mesh + model + kernels + first dt [s]", "wall time [s]",
                    "us/element-step", "peak error", "peak time error"):
@@ -427,8 +454,8 @@ def bench(
                       f"{row['us_per_element_step']:.2f}", f"{row['peak_error_percent']:+.3f}%",
                       f"{row['peak_time_error_percent']:+.3f}%")
     out.print(table)
-    out.print("contact between shells: measuring", highlight=False)
-    contact = contact_cost()
+    with err.status("bench: contact between shells, two plates of 9,800 elements") as status, _compiles_shown(status):
+        contact = contact_cost()
     costs = Table(title="contact between shells (two stacked plates, every node touching)", title_justify="left")
     for column in ("scene", "elements", "us/element-step", "contact's share of the step"):
         costs.add_column(column)

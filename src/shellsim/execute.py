@@ -44,7 +44,7 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
     clock = Stopwatch()
     mesh = sized_mesh(scene, deck_folder, announce)
     mesh_s = clock.lap()
-    announce("building the model; then the kernels (compiled on first use, about two minutes)")
+    announce("building the model")
     model = build_model(scene, mesh)
     model_s = clock.lap()
     run = prepare(scene, mesh, model)

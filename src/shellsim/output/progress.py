@@ -1,6 +1,7 @@
 """Progress of a run: a rich bar on a terminal (simulated time, step, steps per second,
-energy balance, the worst element's Jacobian ratio J/J0, time left), a line every tenth of
-the run otherwise, nothing when quiet."""
+energy balance, the worst element's Jacobian ratio J/J0, time left, time taken, and the
+kernel compiling on a first run), a line every tenth of the run otherwise, nothing when
+quiet."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ import time
 
 from rich.console import Console
 from rich.markup import escape
-from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
+from ..compile_watch import FIRST_RUN_NOTE
 from ..solver.run import Listener, Run
 
 
@@ -31,14 +33,32 @@ class ProgressDisplay(Listener):
             self.bar = Progress(TextColumn("[bold]t = {task.fields[t]}"), BarColumn(),
                                 TextColumn("dt {task.fields[dt]}  {task.fields[rate]} steps/s  "
                                            "balance {task.fields[balance]}  J/J0 {task.fields[quality]}"),
-                                TimeRemainingColumn(), console=console, transient=True)
-            self.task = self.bar.add_task("run", total=end_time, t="0", dt="-", rate="-", balance="-", quality="-")
+                                TimeRemainingColumn(), TimeElapsedColumn(), TextColumn("{task.fields[stage]}"),
+                                console=console, transient=True)
+            self.task = self.bar.add_task("run", total=end_time, t="0", dt="-", rate="-", balance="-", quality="-",
+                                          stage="")
             self.bar.start()
+        self.compiled_any = False
 
     def announce(self, text: str) -> None:
         """A stage of the work before the first step (meshing, the mesh's size, building)."""
         if not self.quiet:
             self.console.print(f"[dim]{escape(text)}[/]", highlight=False)
+
+    def compiling(self, name: str) -> None:
+        """A kernel begins to compile (:mod:`shellsim.compile_watch`)."""
+        if not self.compiled_any:
+            self.compiled_any = True
+            self.announce(f"compiling the kernels ({FIRST_RUN_NOTE})")
+        if self.bar is not None and not self.quiet:
+            self.bar.update(self.task, stage=f"compiling {name}")
+
+    def compiled(self, name: str, seconds: float) -> None:
+        """A kernel has compiled in ``seconds``."""
+        if self.bar is not None and not self.quiet:
+            self.bar.update(self.task, stage="")
+        if seconds >= 5.0:
+            self.announce(f"compiled {name} in {seconds:.0f} s")
 
     def on_dt(self, run: Run) -> None:
         """At the first estimate: the step and what the run will cost."""

@@ -4,6 +4,7 @@ results on the deformed shape. Works with no display: VTK renders through EGL.""
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -179,13 +180,14 @@ class Drawn(NamedTuple):
 NO_OVERLAYS = Overlays()
 
 
-def render_field(folder: Path, field: str = "pressure_band", frame: str | int = "last", view: str = "iso",
+def render_field(folder: Path, field: str = "pressure_band", frame: str | int = "last", view: str = "iso",  # noqa: PLR0913 (the render command's options, each defaulted)
                  size: tuple[int, int] = (1200, 900), component: str | None = None,
-                 out_dir: Path | None = None, overlays: Overlays = NO_OVERLAYS) -> list[Path]:
+                 out_dir: Path | None = None, overlays: Overlays = NO_OVERLAYS,
+                 on_frame: Callable[[int, int], None] = lambda done, total: None) -> list[Path]:
     """PNGs of ``field`` on the deformed shape for the chosen frames of the series in
     ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
-    to ``out_dir`` (default ``folder/renders``), with the ``overlays``. Returns the files
-    written."""
+    to ``out_dir`` (default ``folder/renders``), with the ``overlays``. ``on_frame(done,
+    total)`` hears of each picture written. Returns the files written."""
     from .fields import FIBRE_PREFIX, NODAL_SUFFIX, labelled
     from .series import CABLES, StoredSeries
 
@@ -223,6 +225,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
                       f"{title}\nt = {series.times[index]:.6g}", path,
                       Drawn(series.points if overlays.outline else None, fibres, chords))
         written.append(path)
+        on_frame(len(written), len(indices))
     if frame == "all":
         import imageio.v3 as iio
 

@@ -12,9 +12,7 @@ from __future__ import annotations
 
 import math
 import os
-import statistics
 import time
-from collections import deque
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -74,57 +72,76 @@ def kernel_threads(count: int) -> Iterator[None]:
         numba.set_num_threads(before)
 
 
+#: Steps of each block before the chooser knows the current count's pace.
+FIRST_BLOCK_STEPS = 8
+
+
 class ThreadChooser:
     """Chooses, block by block of steps, between one thread and ``most``: it runs at its
-    current count and, every ``probe_interval`` seconds, tries the other count on a block
-    of about ``probe_seconds`` at the current pace, switching when that block went faster
-    per step than the current count's recent blocks. A probe that loses waits twice as
-    long before the next, up to ``longest_interval``: where the other count is 7x slower
-    the probes cost about 1% of the run, and a change of load is followed within that
-    interval.
+    current count and, from its second timed block on and then every ``probe_interval``
+    seconds, tries the other count on a block of about ``probe_seconds`` at the current
+    pace, switching when the other count's pace is the better. A count's pace is its
+    seconds over its steps, both fading with the time stepped (``memory`` seconds): on a
+    loaded machine a parallel loop runs fast for a while and then stalls, so a short probe
+    that caught no stall does not outweigh the stalls its count had. A probe that loses
+    waits twice as long before the next, up to ``longest_interval``: where the other
+    count is 7x slower the probes cost under 2% of the run, and a change of load is
+    followed within about ``longest_interval`` + ``memory`` seconds.
 
     Use: ``count, steps = chooser.plan(max_steps)``, run at most ``steps`` steps on
     ``count`` threads, then ``chooser.record(count, steps_taken, seconds)``. With
     ``choose`` False it always answers ``most`` (a measurement of that count)."""
 
-    def __init__(self, most: int, choose: bool = True, probe_interval: float = 1.0, probe_seconds: float = 0.01,
-                 longest_interval: float = 8.0, clock: Callable[[], float] = time.perf_counter):
+    def __init__(self, most: int, choose: bool = True, probe_interval: float = 1.0, probe_seconds: float = 0.02,
+                 longest_interval: float = 8.0, memory: float = 5.0, clock: Callable[[], float] = time.perf_counter):
         self.counts = (most, 1) if choose and most > 1 else (most,)
         self.current = most
         self.probe_interval = probe_interval
         self.probe_seconds = probe_seconds
         self.longest_interval = longest_interval
+        self.memory = memory
         self.clock = clock
         self._interval = probe_interval
         self._next_probe: float | None = None  # set after the first block (which may compile)
-        self._recent: deque[float] = deque(maxlen=5)  # seconds per step at the current count
+        self._seconds = dict.fromkeys(self.counts, 0.0)  # fading sums of each count's blocks
+        self._steps = dict.fromkeys(self.counts, 0.0)
 
     @property
     def other(self) -> int:
         """The count a probe tries."""
         return self.counts[1] if self.current == self.counts[0] else self.counts[0]
 
+    def pace(self, count: int) -> float:
+        """Seconds per step on ``count`` threads as measured (inf before any block)."""
+        return self._seconds[count] / self._steps[count] if self._steps[count] else math.inf
+
     def plan(self, max_steps: int) -> tuple[int, int]:
         """(threads, steps) for the next block of at most ``max_steps`` steps: the current
         count, or a probe of the other count on a few steps."""
-        if len(self.counts) == 1 or not self._recent or self.clock() < self._next_probe:
+        if len(self.counts) == 1:
             return self.current, max_steps
-        steps = max(4, int(self.probe_seconds / statistics.median(self._recent)))
-        return self.other, min(max_steps, steps)
+        if not self._steps[self.current]:  # short blocks until a pace is known: the count may be the slow one
+            return self.current, min(max_steps, FIRST_BLOCK_STEPS)
+        if self.clock() < self._next_probe:
+            return self.current, max_steps
+        return self.other, min(max_steps, max(4, int(self.probe_seconds / self.pace(self.current))))
 
     def record(self, count: int, steps: int, seconds: float) -> None:
         """A block of ``steps`` steps took ``seconds`` on ``count`` threads."""
         if steps <= 0 or len(self.counts) == 1:
             return
-        pace = seconds / steps
-        if self._next_probe is None:  # the first block may hold the kernels' compilation
-            self._next_probe = self.clock() + self._interval
-        elif count == self.current:
-            self._recent.append(pace)
-        else:
-            if self._recent and pace < statistics.median(self._recent):
+        if self._next_probe is None:  # the first block may hold the kernels' compilation;
+            self._next_probe = self.clock()  # the first probe follows the next block
+            return
+        fade = math.exp(-seconds / self.memory)
+        for c in self.counts:
+            self._seconds[c] *= fade
+            self._steps[c] *= fade
+        self._seconds[count] += seconds
+        self._steps[count] += steps
+        if count != self.current:
+            if self.pace(count) < self.pace(self.current):
                 self.current = count
-                self._recent = deque([pace], maxlen=5)
                 self._interval = self.probe_interval
             else:
                 self._interval = min(2.0 * self._interval, self.longest_interval)

@@ -547,7 +547,9 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                 f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
                                 + (f", damping {sv.damping}/s" if sv.damping else ""))
         row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
-                                   f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end")
+                                   f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end at that "
+                                   "step (it falls as elements crumple or stiffen, and the steps and cost grow "
+                                   "with it; the run's progress shows the step as it goes)")
         row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
                               f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
                               f"{size_text(outlook['bytes'])} of memory")

@@ -28,7 +28,7 @@ class Machine:
         spent = dict.fromkeys(chooser.counts, 0.0)
         while self.now < duration:
             count, steps = chooser.plan(block)
-            assert 1 <= steps <= block
+            assert 0 < steps <= block, (count, steps)  # a plan asks for some steps, never more than allowed
             seconds = steps * self.pace(self.now)[count]
             self.now += seconds
             self.steps += steps

@@ -398,19 +398,26 @@ def report(
     external = read_external(study.parent / plan_.external.path) if plan_.external else []
     rows: list[dict] = []
     write_report(folder, plan_.meta.title, rows, len(jobs), external)
-    with open_client(scheduler, workers, connect_timeout) as client, Progress(console=out, transient=True) as bar:
-        prepare_workers(client, local=scheduler is None)
-        task = bar.add_task(f"{len(jobs)} jobs", total=len(jobs))
+    with err.status(f"connecting to the dask scheduler at {scheduler}" if scheduler else
+                    "starting a local dask cluster"):
+        client = open_client(scheduler, workers, connect_timeout)
+    with client:
+        # from an empty cache the kernels compile here (a local cluster) or in each worker
+        with err.status("the workers load the kernels") as status, _compiles_shown(status):
+            prepare_workers(client, local=scheduler is None)
+        with Progress(console=out, transient=True) as bar:
+            task = bar.add_task(f"{len(jobs)} jobs", total=len(jobs))
 
-        def on_row(row: dict) -> None:
-            rows.append(row)
-            write_report(folder, plan_.meta.title, list(rows_in_order(jobs, rows)), len(jobs) - len(rows), external)
-            bar.advance(task)
-            error = "-" if row["error_percent"] is None else f"{row['error_percent']:.3g}%"
-            out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
+            def on_row(row: dict) -> None:
+                rows.append(row)
+                write_report(folder, plan_.meta.title, list(rows_in_order(jobs, rows)), len(jobs) - len(rows),
+                             external)
+                bar.advance(task)
+                error = "-" if row["error_percent"] is None else f"{row['error_percent']:.3g}%"
+                out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
 
-        # a local cluster has one worker process per core: one kernel thread per job
-        run_jobs(jobs, client, on_row, threads=1 if scheduler is None else None)
+            # a local cluster has one worker process per usable CPU: one kernel thread per job
+            run_jobs(jobs, client, on_row, threads=1 if scheduler is None else None)
     written = [folder / name for name in ("report.md", "report.csv", "error_vs_time.png")]
     if embed_in is not None:
         embed(embed_in, study.stem, list(rows_in_order(jobs, rows)))

@@ -131,7 +131,7 @@ def check(deck: DeckPath) -> None:
 def _compiles_shown(status):
     """The kernels compiling inside the block shown on ``status`` (a rich status line), and
     those that took a while printed when done; the status line returns to what it said."""
-    from .compile_watch import FIRST_RUN_NOTE, watching_compiles
+    from .compile_watch import FIRST_RUN_NOTE, finished_text, watching_compiles
 
     said = []
 
@@ -141,8 +141,8 @@ def _compiles_shown(status):
 
     def end(name: str, seconds: float) -> None:
         status.update(said.pop())
-        if seconds >= 5.0:
-            err.print(f"[dim]compiled {name} in {seconds:.0f} s[/]", highlight=False)
+        if text := finished_text(name, seconds):
+            err.print(f"[dim]{escape(text)}[/]", highlight=False)
 
     return watching_compiles(start, end)
 

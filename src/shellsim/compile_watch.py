@@ -17,6 +17,13 @@ from numba.core import event
 #: What a user is told when the kernels compile: once per version, and how long in all
 #: (warming the cache, study.executor.warm_numba_cache, from empty: docs/verification.md).
 FIRST_RUN_NOTE = "once for this version of shellsim: about 3 minutes in all on 2 idle cores"
+#: Kernels that compile longer than this [s] are named when done; the rest pass quietly.
+WORTH_TELLING = 5.0
+
+
+def finished_text(name: str, seconds: float) -> str | None:
+    """The line that tells a kernel has compiled, for one that took a while (else None)."""
+    return f"compiled {name} in {seconds:.0f} s" if seconds >= WORTH_TELLING else None
 
 
 def kernel_name(dispatcher) -> str:

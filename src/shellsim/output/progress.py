@@ -12,7 +12,7 @@ from rich.markup import escape
 from rich.progress import BarColumn, Progress, ProgressColumn, TextColumn, TimeRemainingColumn
 from rich.text import Text
 
-from ..compile_watch import FIRST_RUN_NOTE
+from ..compile_watch import FIRST_RUN_NOTE, finished_text
 from ..solver.run import Listener, Run
 
 
@@ -72,8 +72,8 @@ class ProgressDisplay(Listener):
         """A kernel has compiled in ``seconds``."""
         if self.bar is not None:
             self.bar.update(self.task, status=self.status, compiling_since=None)
-        if seconds >= 5.0:
-            self.announce(f"compiled {name} in {seconds:.0f} s")
+        if text := finished_text(name, seconds):
+            self.announce(text)
 
     def on_dt(self, run: Run) -> None:
         """At the first estimate: the step and what the run will cost."""

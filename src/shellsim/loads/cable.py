@@ -168,7 +168,7 @@ def build(table: Cable, scene) -> Bundle:
                   gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _tension(x, cables, k, e):
     """(N, l, lambda, P') of element k at positions x (n, 3): the tension [force], the
     current length, the stretch and the law's slope; e (3,) receives the unit direction

@@ -72,7 +72,7 @@ def code_and_parameters(law) -> tuple[int, np.ndarray]:
     return OGDEN, np.array([law.mu, alpha, 0.0])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def nominal_stress(law, params, stretch):
     """(P, dP/dlambda) of law ``law`` with ``params`` (3,) at ``stretch``; (0, 0) where the
     cable is shorter than at rest."""

@@ -24,7 +24,7 @@ _NODE_S = (1.0, 1.0, -1.0, -1.0, 1.0, 0.0, -1.0, 0.0, 0.0)
 _ITERATIONS, _CONVERGED, _HALVINGS = 30, 1e-12, 40
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _lagrange(x, node):
     """The 1D quadratic Lagrange polynomial on {-1, 0, 1} that is 1 at ``node``: its
     value, first and second derivatives at x."""
@@ -136,7 +136,7 @@ def nearest_point(x, nodes, y, rs, point, normal, scratch):
     return distance
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _bucket(i, j, k, buckets):
     """The hash bucket of grid cell (i, j, k) among ``buckets``."""
     key = (i * 73856093) ^ (j * 19349663) ^ (k * 83492791)
@@ -221,7 +221,7 @@ def fill_grid(reach, grid):
     return width, origin
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def cell_faces(y, width, origin, start):
     """The range (first, stop) of the entries of the bucket of the cell holding y (3,)."""
     b = _bucket(int(np.floor((y[0] - origin[0]) / width)), int(np.floor((y[1] - origin[1]) / width)),
@@ -229,7 +229,7 @@ def cell_faces(y, width, origin, start):
     return start[b], start[b + 1]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def near_box(y, boxes, f, reach):
     """Whether y (3,) lies within ``reach`` of face row f's box (a lower bound of its
     distance from the face)."""

@@ -212,7 +212,7 @@ def share_of(penalty: float) -> float:
     return float(1.0 / np.sqrt(1.0 + penalty / 4.0))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _distance(loads, m, centre, y, normal):
     """The signed distance of the point y (3,) from tool item m whose point is now
     ``centre`` (3,), positive on the shell's side; writes the unit normal (3,) there."""
@@ -241,7 +241,7 @@ def _distance(loads, m, centre, y, normal):
     return loads.side[m] * (size - loads.radius[m])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _face_gap(loads, m, centre, node, face, y, normal):
     """(arm, gap) of the point y = x + arm d (3,) of ``face`` (-1, 0, +1; arm = face h/2)
     of item m's node = (x, d (3,), fibre length h): its signed distance from the tool at

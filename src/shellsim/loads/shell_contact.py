@@ -286,7 +286,7 @@ def _candidates(shape, loads, m, grid, work, ignoring):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _may_touch(loads, m, row, y, ignoring):
     """Whether contact node m, at y (3,), is tested against face row ``row``: a face of its
     group within the search's reach that does not hold it (nor, where ``ignoring``, one
@@ -328,7 +328,7 @@ def _initial_overlaps(initial, loads):
     return -1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _pair_spring(x, h, loads, m, row, work):
     """(depth, smoothing, spring) of contact node m against face row ``row``, the shape
     (x, h) given: :func:`_depth`'s and the pair's spring k (the module's text; 0 where they

@@ -81,7 +81,7 @@ def search_grid(corners: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarr
     return boxes, start, entries, np.concatenate([[width], origin])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _nearest_on_triangle(p, a, b, c):
     """(row, q0, q1, q2): the point q of the triangle a, b, c (3,) nearest to p (3,) and
     the row of the pseudo-normal of where it lies (Ericson, Real-Time Collision
@@ -120,7 +120,7 @@ def _nearest_on_triangle(p, a, b, c):
     return FACE, a[0] + v * ab0 + w * ac0, a[1] + v * ab1 + w * ac1, a[2] + v * ab2 + w * ac2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def signed_distance(tool, group, p, normal):
     """The signed distance of p (3,, in the file's frame) from the surface ``tool`` = (corners
     (T, 3, 3), pseudo (T, 7, 3), owner (T,), boxes (T, 6), start, entries, frame (4,)

@@ -305,8 +305,19 @@ def _wait_for_frames(path: Path, count: int, process: subprocess.Popen, limit: f
     raise AssertionError(f"no {count} frames in {path} after {limit} s")
 
 
+@pytest.fixture
+def ctrl_c_delivered():
+    """Ctrl-C raising KeyboardInterrupt in this process for the test, and the default
+    action in the processes it starts, however the suite was started: a shell starting
+    it in the background (``make test &``) has it ignored, and children inherit that."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)  # a child's preexec_fn
+    signal.signal(signal.SIGINT, previous)
+
+
 @pytest.mark.parametrize(("stop", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
-def test_a_stopped_run_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path, stop, code):
+def test_a_stopped_run_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path, stop, code,
+                                                                                ctrl_c_delivered):
     deck = tmp_path / "long.toml"
     # a dead load: under the follower pressure this cantilever flutters and folds by t = 9,
     # which a loaded machine can reach before the signal lands
@@ -315,7 +326,7 @@ def test_a_stopped_run_leaves_a_readable_series_and_a_summary_marked_interrupted
                     .replace('curve = "ramp"', 'curve = "ramp"\nfollower = false'))
     out = tmp_path / "out"
     process = subprocess.Popen([sys.executable, "-m", "shellsim", "run", str(deck), "--out", str(out), "--quiet"],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=ctrl_c_delivered)
     _wait_for_frames(out / "results.xdmf", 3, process)
     process.send_signal(stop)
     _, stderr = process.communicate(timeout=60)
@@ -347,7 +358,7 @@ class _StoppedMidFrame(Listener):
 
 
 @pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
-def test_a_stop_during_a_frame_lands_after_the_whole_frame_is_written_and_counted(stop):
+def test_a_stop_during_a_frame_lands_after_the_whole_frame_is_written_and_counted(stop, ctrl_c_delivered):
     run = prepared(parse_deck(PLATE))
     listener = _StoppedMidFrame(stop)
     with pytest.raises(KeyboardInterrupt), sigterm_as_interrupt([]):

@@ -66,6 +66,7 @@ class Simulation:
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
                                  stiffness=TypedCall(stiffness_product))
         self._eigenvector: np.ndarray | None = None
+        self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
         self.update_masses()
         self.evaluate_forces()
@@ -99,9 +100,9 @@ class Simulation:
         return tuple(out)
 
     def critical_time_step(self, on_product: Callable[[int], None] | None = None) -> float:
-        """dt_critical = 2 / omega_max at the current state (warm-started Lanczos);
+        """dt_critical = 2 / omega_max at the current state (Lanczos, from the last eigenvector after the first);
         ``on_product(count)`` hears of each stiffness product."""
-        dt, self._eigenvector = critical_time_step(self, self._eigenvector, on_product)
+        dt, self._eigenvector = critical_time_step(self, self._eigenvector, on_product, self._fresh)
         return dt
 
     def evaluate_forces(self) -> None:

@@ -23,7 +23,7 @@ def _history(folder) -> dict[str, np.ndarray]:
 
 def _run_coarse(deck_name: str, overrides: dict, folder):
     """The deck with ``overrides`` run into ``folder`` (its files read beside it), with its
-    renders; returns ``folder``."""
+    renders; returns (``folder``, the run)."""
     from shellsim.cli import _deck_renders
     from shellsim.execute import run_scene
 
@@ -32,7 +32,7 @@ def _run_coarse(deck_name: str, overrides: dict, folder):
     run, _ = run_scene(scene, source, folder)
     assert run.status == "completed"
     _deck_renders(scene, folder, quiet=True)
-    return folder
+    return folder, run
 
 
 def _has_fibres_and_a_picture(out) -> None:
@@ -50,7 +50,7 @@ def _has_fibres_and_a_picture(out) -> None:
 def carotid(tmp_path_factory):
     """Two cycles on quads of about 3 mm (253 elements), frames every 0.08 s."""
     return _run_coarse("carotid_hgo_pulse.toml", {"geometry.element_size": 0.003, "solver.end_time": 1.6,
-                                                  "output.interval": 0.08}, tmp_path_factory.mktemp("carotid"))
+                                                  "output.interval": 0.08}, tmp_path_factory.mktemp("carotid"))[0]
 
 
 def test_the_carotid_repeats_its_shape_each_cycle_and_widens_with_the_pressure(carotid):
@@ -77,7 +77,7 @@ def test_the_remeshed_carotid_has_its_named_ends(carotid):
 
 @pytest.fixture(scope="module")
 def leaflet(tmp_path_factory):
-    """The flap as shipped (30 elements) up to 0.15 s."""
+    """The flap as shipped (30 elements) up to 0.15 s: (its folder, the run)."""
     return _run_coarse("leaflet_lee_sacks_pulse.toml", {}, tmp_path_factory.mktemp("leaflet"))
 
 
@@ -86,10 +86,22 @@ def test_the_leaflet_bellies_under_the_pulse_and_comes_back(leaflet):
     is on, beyond a tenth of the flap's height), the fibres along the annulus are
     stretched (tension at the belly), and after the pulse the damped flap returns to within
     a twentieth of its largest deflection."""
-    history = _history(leaflet)
+    folder, _ = leaflet
+    history = _history(folder)
     t, deflection = history["time"], history["free_edge_deflection"]
     peak = int(np.argmax(deflection))
     assert 0.0 < t[peak] < 0.1 and deflection[peak] > 0.001
     assert abs(deflection[-1]) < deflection[peak] / 20
     assert history["belly_stress"][np.argmin(abs(t - 0.05))] > 0.0
-    _has_fibres_and_a_picture(leaflet)
+    _has_fibres_and_a_picture(folder)
+
+
+def test_the_crumpling_flaps_step_stays_below_each_next_critical_step(leaflet):
+    """The flap's critical step swings by 20 times as it crumples and rebounds; estimated as
+    often as it moves (more often than every 100 steps), every step taken is shorter than
+    the critical step estimated after it."""
+    _, run = leaflet
+    record = run.dt_history
+    assert max(critical for _, critical, _ in record) > 20 * min(critical for _, critical, _ in record)
+    assert len(record) > run.sim.state.steps / 100
+    assert all(dt < critical for (_, _, dt), (_, critical, _) in zip(record, record[1:]))

@@ -196,7 +196,10 @@ class Solver(Section):
     ``[solver.static]``).
 
     Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
-    inverse), Δt_critical re-estimated every ``dt_update_every`` steps. ``mass``: lumped M1
+    inverse), Δt_critical re-estimated at least every ``dt_update_every`` steps, and more
+    often while it moves: each interval is as long as keeps its change, at the fastest rate
+    seen over the last ``dt_update_every`` steps, within a quarter of the margin the safety
+    factor leaves (5 steps to the first, each at most twice the one before). ``mass``: lumped M1
     (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
     coefficient in 1/s (0 = undamped, the default).
 

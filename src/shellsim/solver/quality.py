@@ -50,21 +50,37 @@ class ElementQuality:
         return Worst(t, e, float(ratios[e]))
 
 
-def folding_diagnosis(ratios: np.ndarray, x: np.ndarray, conn: np.ndarray) -> str | None:
+#: What to do about a crushed or folded element.
+ADVICE = ("The mesh is too coarse there for this deformation, or the load comes on too fast: refine the mesh "
+          "around that element, or ramp the load more slowly")
+
+
+def folding_diagnosis(ratios: np.ndarray, x: np.ndarray, conn: np.ndarray,
+                      massless: np.ndarray | None = None) -> str | None:
     """What a breakdown's message says of the mesh: the crushed or folded elements, the worst
-    first, with where it is and what to do; None when every element's ratio is above
-    CRUSHED. ratios (ne,) of :meth:`ElementQuality.ratios`, x (n, 3) the positions to place
-    it by (the mesh as built), conn (ne, 9)."""
+    first, with where it is and what to do; else, when nodes ``massless`` (indices) have lumped masses
+    no longer positive (the masses on the current shape give way before the Gauss points
+    fold), the worst element around them; None when neither. ratios (ne,) of
+    :meth:`ElementQuality.ratios`, x (n, 3) the positions to place it by (the mesh as
+    built), conn (ne, 9)."""
     crushed = np.flatnonzero(ratios < CRUSHED)
     if not crushed.size:
-        return None
+        return _massless_diagnosis(ratios, x, conn, massless) if massless is not None and massless.size else None
     crushed = crushed[np.argsort(ratios[crushed])]
     worst = crushed[0]
     state = "has folded over" if ratios[worst] <= FOLDED else "is crushed"
     return (f"element {worst + 1} (counting from 1) at {place(x[conn[worst]].mean(axis=0))} {state}: its "
             f"volume ratio det J / det J0 is {ratios[worst]:.3g}; {crushed.size} element(s) are below {CRUSHED:g} "
-            f"({id_list(crushed + 1)}). The mesh is too coarse there for this deformation, or the load comes "
-            "on too fast: refine the mesh around that element, or ramp the load more slowly")
+            f"({id_list(crushed + 1)}). {ADVICE}")
+
+
+def _massless_diagnosis(ratios: np.ndarray, x: np.ndarray, conn: np.ndarray, massless: np.ndarray) -> str:
+    around = np.flatnonzero(np.isin(conn, massless).any(axis=1))
+    worst = around[np.argmin(ratios[around])]
+    nodes = np.intersect1d(conn[worst], massless)
+    return (f"element {worst + 1} (counting from 1) at {place(x[conn[worst]].mean(axis=0))} is distorted beyond "
+            f"what its lumped masses bear: the masses of its node(s) {id_list(nodes + 1)} are no longer positive, "
+            f"its volume ratio det J / det J0 is {ratios[worst]:.3g}. {ADVICE}")
 
 
 def step_history(dt_history: list[tuple[float, float, float]]) -> str:

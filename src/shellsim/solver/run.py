@@ -31,6 +31,7 @@ from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
+from .timestep import EstimateSchedule
 from .valve import VALVE_COLUMNS, ValveMeasures, resolve_valve
 
 #: History samples over a run (fewer when the run has fewer steps).
@@ -241,12 +242,17 @@ def _frame(run: Run, listener: Listener) -> None:
         run.frame_times.append(run.sim.state.t)
 
 
-def _update_time_step(run: Run, listener: Listener) -> None:
+def _watch_quality(run: Run) -> None:
+    """Each element's Jacobian ratio now, the worst now and the worst seen into ``run``."""
     s = run.sim.state
     run.ratios = run.quality.ratios(s.x, s.d, s.h)
     run.worst = run.quality.worst(s.t, run.ratios)
     if run.lowest is None or run.worst.ratio < run.lowest.ratio:
         run.lowest = run.worst
+
+
+def _update_time_step(run: Run, listener: Listener) -> None:
+    _watch_quality(run)
     run.sim.update_masses()
     run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, run.sim.critical_time_step())
     run.dt = time_step(run.deck.solver, run.dt_critical)
@@ -269,13 +275,15 @@ def _check_stability(run: Run) -> None:
 
 def _breakdown_cause(run: Run) -> str:
     """Why the run broke down: the crushed or folded elements and where they are if the
-    mesh has given way (its state now, or at the last step update if now is no number),
+    mesh has given way (its state now, watched as at a step update, or at the last step
+    update if now is no number),
     else the time step; and how the critical step moved just before."""
     s = run.sim.state
-    ratios = run.ratios
     if np.isfinite(s.x).all() and np.isfinite(s.d).all() and np.isfinite(s.h).all():
-        ratios = run.quality.ratios(s.x, s.d, s.h)
-    folding = folding_diagnosis(ratios, run.mesh.x, run.mesh.conn) if ratios is not None else None
+        _watch_quality(run)
+    ratios = run.ratios
+    massless = np.flatnonzero(~((s.mt > 0.0) & (s.mr > 0.0)))
+    folding = folding_diagnosis(ratios, run.mesh.x, run.mesh.conn, massless) if ratios is not None else None
     # a step above the critical one wrecks every shape too: then the step is named as well
     step = _time_step_hint(run) if not folding or run.deck.solver.dt_safety_factor < 1 else ""
     return (f"; {folding}" if folding else "") + step + step_history(run.dt_history)
@@ -318,6 +326,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
         if not run.times:  # else it continues a preload, whose last state is recorded
             _record(run, listener)
             _frame(run, listener)
+        schedule = EstimateSchedule(solver.dt_safety_factor, solver.dt_update_every)
+        interval = schedule.after_estimate(sim.state.steps, run.dt_critical)
         since_update = 0
         history_interval = solver.end_time / HISTORY_SAMPLES
         landings = output_times(run.deck)
@@ -327,10 +337,11 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 step = equal_step(landing - sim.state.t, run.dt)
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
                 while sim.state.t < target:
-                    steps = sim.advance(target, step, solver.dt_update_every - since_update)
+                    steps = sim.advance(target, step, interval - since_update)
                     since_update += steps
-                    if since_update >= solver.dt_update_every:
+                    if since_update >= interval:
                         _update_time_step(run, listener)
+                        interval = schedule.after_estimate(sim.state.steps, run.dt_critical)
                         since_update = 0
                         break  # re-plan the steps with the new dt
                 _record(run, listener)

@@ -23,6 +23,8 @@ RUN = {
     "test01_nafems_21t_4x4.toml": {},
     "test02_cantilever_uniform_load_3.toml": {},
     "test02_cantilever_uniform_load_3_static.toml": {},
+    "test02_cantilever_uniform_load_3_mass_scaled.toml": {},
+    "test02_cantilever_uniform_load_3_relaxed.toml": {},
     "test03_strip_moment_regular3.toml": {},
     "test03_strip_moment_irregular3_thick.toml": {},
     # Test 4 to 108 degrees on 6 square elements: with nu = 0 and loads per unit width the

@@ -118,7 +118,8 @@ class Model(NamedTuple):
     rule, mesh, material, loads, curves and supports, and the initial shape (n nodes):
     x0, d0 (n, 3) mid-surface and directors, e1f0 (n, 3) fibre-frame first axes;
     density [mass/length^3]; mass 'M1' or 'M2' (thesis 3.14); damping [1/s]
-    (mass-proportional)."""
+    (mass-proportional); kinetic_damping: every velocity set to zero at each peak of the
+    kinetic energy (dynamic relaxation)."""
 
     rule: Rule
     body: Body
@@ -132,6 +133,7 @@ class Model(NamedTuple):
     density: float
     mass: str
     damping: float
+    kinetic_damping: bool
 
     @property
     def h0(self) -> np.ndarray:

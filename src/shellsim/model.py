@@ -93,6 +93,7 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
         rule=rule, body=body, material=_material(deck, mesh, rule), loads=loads, curves=curves,
         constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0,
         density=deck.material.density, mass=deck.solver.mass, damping=deck.solver.damping,
+        kinetic_damping=deck.solver.relaxation is not None,
     )
 
 

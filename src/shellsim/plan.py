@@ -40,4 +40,5 @@ def plan(deck: Deck) -> Plan:
         **load_features([table for key in DECK_KEYS for table in getattr(deck, key)]),
         "prescribed_motion": any(bc.type == "prescribed" for bc in deck.boundary),
         "damping": deck.solver.damping > 0.0,
+        "kinetic_damping": deck.solver.relaxation is not None,
     })

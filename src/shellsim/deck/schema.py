@@ -189,6 +189,30 @@ class Static(Section):
     min_increment: Positive = 1e-6
 
 
+class MassScaling(Section):
+    """``[solver.mass_scaling]``: uniform mass scaling for a quasi-static explicit run.
+    When the first time step is shorter than ``step``, every mass (translational, rotary,
+    the cables') is multiplied by (``step`` / Δt)², which makes the step ``step``: that
+    many times fewer steps to the end time. The factor and the mass added are reported
+    (``mass_scaling`` in summary.json). Every period of the structure grows by the same
+    factor as the step, so the loads must still come on slowly against the longest one,
+    and a mass-proportional ``damping`` acts (step / Δt) times more strongly on it."""
+
+    step: Positive
+
+
+class Relaxation(Section):
+    """``[solver.relaxation]``: dynamic relaxation by kinetic damping, for an explicit run
+    whose answer is the state of rest. Whenever the kinetic energy has passed a peak,
+    every velocity is set to zero (the energy taken counted as damping work). Once every
+    curve holds its last value, the run ends at the first history sample whose residual
+    force (over the free DOFs) is within ``residual`` of the larger of the external and
+    internal force norms, as a static step converges; ``relaxation`` in summary.json
+    records when and how far."""
+
+    residual: Positive = 1e-4
+
+
 class Solver(Section):
     """``[solver]``: central differences from t = 0 to ``end_time`` (``method =
     "explicit"``, the default), or static equilibrium by Newton-Raphson load steps over
@@ -201,7 +225,8 @@ class Solver(Section):
     seen over the last ``dt_update_every`` steps, within a quarter of the margin the safety
     factor leaves (5 steps to the first, each at most twice the one before). ``mass``: lumped M1
     (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
-    coefficient in 1/s (0 = undamped, the default).
+    coefficient in 1/s (0 = undamped, the default). ``mass_scaling`` and ``relaxation``
+    reach a state of rest in fewer steps (``[solver.mass_scaling]``, ``[solver.relaxation]``).
 
     ``preload``: a time before ``end_time`` up to which an explicit run is solved
     statically instead (load steps of ``[solver.static]``), the way an explicit code's
@@ -219,6 +244,17 @@ class Solver(Section):
     dt_max: Positive | None = None
     mass: Literal["M1", "M2"] = "M2"
     damping: NonNegative = 0.0
+    mass_scaling: MassScaling | None = None
+    relaxation: Relaxation | None = None
+
+    @model_validator(mode="after")
+    def _explicit_only(self) -> "Solver":
+        if self.method == "static":
+            for key in ("mass_scaling", "relaxation"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"'{key}' is for explicit runs; a static run has no masses or time steps "
+                                     "to scale or relax, so drop it or set method = 'explicit'")
+        return self
 
     @model_validator(mode="after")
     def _preload_fits(self) -> "Solver":

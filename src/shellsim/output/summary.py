@@ -73,6 +73,9 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
         **({"contact": contact_record(run, output_seconds)} if run.tool_forces is not None else {}),
         **({"valve": valve_record(run)} if run.valve is not None else {}),
+        **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0)}}
+           if run.deck.solver.mass_scaling is not None else {}),
+        **({"relaxation": run.relaxing.record(run.sim)} if run.relaxing is not None else {}),
         "reference": reference_results(run),
     }
 

@@ -38,7 +38,8 @@ class Workspace(NamedTuple):
     the last step's mid-surface and director increments; g (n, 3) director-conjugate
     external forces; parts: the element results before assembly (:class:`shellsim.element.assembly.Assembly`);
     friction: whether the contacts have friction, then f_fr (n, 3), fr_fr (n, 2) its
-    forces at t (part of the external ones; (0, 3), (0, 2) without)."""
+    forces at t (part of the external ones; (0, 3), (0, 2) without); relax (2,): under
+    kinetic damping, the last step's kinetic energy and the count of velocity resets."""
 
     dx: np.ndarray
     dd: np.ndarray
@@ -47,6 +48,7 @@ class Workspace(NamedTuple):
     friction: bool
     f_fr: np.ndarray
     fr_fr: np.ndarray
+    relax: np.ndarray
 
 
 def workspace(model) -> Workspace:
@@ -56,7 +58,7 @@ def workspace(model) -> Workspace:
     m = n if friction else 0
     return Workspace(dx=np.zeros((n, 3)), dd=np.zeros((n, 3)), g=np.zeros((n, 3)),
                      parts=assembly(n, len(model.body.conn)), friction=friction,
-                     f_fr=np.zeros((m, 3)), fr_fr=np.zeros((m, 2)))
+                     f_fr=np.zeros((m, 3)), fr_fr=np.zeros((m, 2)), relax=np.zeros(2))
 
 
 @njit(cache=True)
@@ -84,6 +86,30 @@ def half_work(f, fr, dx, w, step):
         for j in range(2):
             work += 0.5 * fr[node, j] * step * w[node, j]
     return work
+
+
+@njit(cache=True)
+def kinetic_damping(v, w, mt, mr, kinetic, work, relax):
+    """Dynamic relaxation by kinetic damping: when the kinetic energy of the new
+    velocities v (n, 3), w (n, 2) is below the last step's (a peak has passed), every one
+    is set to zero, and ``kinetic``, the step's kinetic energy on record, is taken out as
+    damping work. relax (2,): the last step's kinetic energy, the count of resets.
+    Returns the step's kinetic energy on record."""
+    now = 0.0
+    for node in range(v.shape[0]):
+        for i in range(3):
+            now += 0.5 * mt[node] * v[node, i] * v[node, i]
+        for j in range(2):
+            now += 0.5 * mr[node] * w[node, j] * w[node, j]
+    if now >= relax[0]:
+        relax[0] = now
+        return kinetic
+    v[:] = 0.0
+    w[:] = 0.0
+    relax[0] = 0.0
+    relax[1] += 1.0
+    work[DAMPED] += kinetic
+    return 0.0
 
 
 @njit(cache=True)
@@ -141,6 +167,8 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
                                              + dt_avg * (fr_ext[node, j] - fr_int[node, j]) / mr[node]) / (1.0 + 0.5 * c)
                 kinetic += 0.5 * mr[node] * w[node, j] * w_new
                 w[node, j] = w_new
+        if model.kinetic_damping:
+            kinetic = kinetic_damping(v, w, mt, mr, kinetic, work, space.relax)
         for p in range(prescribed.nodes.shape[0]):
             node, i = prescribed.nodes[p], prescribed.axes[p]
             target = model.x0[node, i] + prescribed.values[p] * factor(model.curves, prescribed.curves[p], t + step)

@@ -26,6 +26,7 @@ from ..loads import ToolForces, calibrate, measure_names, stable_step
 from ..mesh import Mesh
 from ..model import Model
 from .probes import Probe, probe_value, resolve_probes
+from .relaxation import Relaxing
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
@@ -72,6 +73,7 @@ class Run:
     load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
     tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
     valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS
+    relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
 
     @property
     def load_time(self) -> float:
@@ -186,6 +188,8 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
         calibrate(model, s.mt, s.mr, run.sim.critical_time_step())
         run.sim.evaluate_forces()  # the springs act from the start
         run.tool_forces = ToolForces(model, names)
+    if deck.solver.relaxation is not None:
+        run.relaxing = Relaxing(run, deck.solver.relaxation.residual)
     run.valve = resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)
     if run.valve is not None:
         run.history |= {column: [] for column in VALVE_COLUMNS}
@@ -260,6 +264,16 @@ def _update_time_step(run: Run, listener: Listener) -> None:
     listener.on_dt(run)
 
 
+def _scale_masses(run: Run, listener: Listener) -> None:
+    """Mass scaling: when the first step is shorter than the deck's target, every mass
+    times (target / step)^2 and the step estimated again (a second entry at t = 0)."""
+    scaling = run.deck.solver.mass_scaling
+    if scaling is None or run.dt >= scaling.step:
+        return
+    run.sim.mass_factor = (scaling.step / run.dt) ** 2
+    _update_time_step(run, listener)
+
+
 def _check_stability(run: Run) -> None:
     s = run.sim.state
     e = s.energy
@@ -310,7 +324,7 @@ def _time_step_hint(run: Run) -> str:
 
 def integrate(run: Run, listener: Listener | None = None) -> Run:
     """Integrate the scene from its state's time (0, or the end of a preload) to the
-    deck's end time.
+    deck's end time, or, relaxing (``[solver.relaxation]``), until it comes to rest.
 
     Raises SceneTooLarge (status 'refused') when its steps would take longer than anyone
     waits, before the first sample; NumericalError when the run goes unstable (the samples recorded until then stay
@@ -321,6 +335,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     sim = run.sim
     with ending(run, listener, "unstable", _breakdown_cause) as start:
         _update_time_step(run, listener)
+        _scale_masses(run, listener)
         refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
         run.startup["first_dt_s"] = time.perf_counter() - start
         if not run.times:  # else it continues a preload, whose last state is recorded
@@ -331,8 +346,9 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
         since_update = 0
         history_interval = solver.end_time / HISTORY_SAMPLES
         landings = output_times(run.deck)
+        at_rest = False
         for landing in landings[landings > sim.state.t]:
-            while sim.state.t < landing:
+            while sim.state.t < landing and not at_rest:
                 # equal steps up to the next output time, history samples on whole steps
                 step = equal_step(landing - sim.state.t, run.dt)
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
@@ -346,7 +362,10 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                         break  # re-plan the steps with the new dt
                 _record(run, listener)
                 _check_stability(run)
+                at_rest = run.relaxing is not None and run.relaxing.at_rest(sim)
             _frame(run, listener)
+            if at_rest:
+                break
     return run
 
 

@@ -68,14 +68,19 @@ class Simulation:
         self._eigenvector: np.ndarray | None = None
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
+        self.mass_factor = 1.0  # every mass scaled by it (mass scaling)
         self.update_masses()
         self.evaluate_forces()
 
     def update_masses(self) -> None:
-        """Lumped masses on the current configuration (M1 or M2, thesis 3.14), the cables' added."""
+        """Lumped masses on the current configuration (M1 or M2, thesis 3.14), the cables'
+        added, all times ``mass_factor``."""
         m, s = self.model, self.state
         self.compiled.masses(m.rule, m.body, s.fields.shape, float(m.density), m.mass == "M1", s.mt, s.mr)
         add_masses(m, s.mt, s.mr)
+        if self.mass_factor != 1.0:
+            s.mt *= self.mass_factor
+            s.mr *= self.mass_factor
 
     def volume(self, initial: bool = False) -> float:
         """Volume of the shell body now (or at the start) [length^3]: int dv over every

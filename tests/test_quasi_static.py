@@ -22,31 +22,25 @@ def _tip(run) -> float:
 
 
 @pytest.fixture(scope="module")
-def newton():
-    """The static answer of the 3-element cantilever: Newton load steps."""
-    return run_deck(load_deck(VERIFICATION / f"{CANTILEVER}_static.toml"))
+def cantilever():
+    """The 3-element cantilever run by one of its decks, named by the suffix of its file
+    ("_static": Newton load steps; "": the ramp and hold to t = 0.12 with viscous damping;
+    "_mass_scaled", "_relaxed"), each run once."""
+    runs = {}
+
+    def run(suffix: str):
+        if suffix not in runs:
+            runs[suffix] = run_deck(load_deck(VERIFICATION / f"{CANTILEVER}{suffix}.toml"))
+        return runs[suffix]
+
+    return run
 
 
-@pytest.fixture(scope="module")
-def plain():
-    """The ramp and hold with mass-proportional damping, to t = 0.12."""
-    return run_deck(load_deck(VERIFICATION / f"{CANTILEVER}.toml"))
-
-
-@pytest.fixture(scope="module")
-def scaled():
-    return run_deck(load_deck(VERIFICATION / f"{CANTILEVER}_mass_scaled.toml"))
-
-
-@pytest.fixture(scope="module")
-def relaxed():
-    return run_deck(load_deck(VERIFICATION / f"{CANTILEVER}_relaxed.toml"))
-
-
-def test_mass_scaling_reaches_the_static_answer_in_fewer_steps(newton, plain, scaled):
+def test_mass_scaling_reaches_the_static_answer_in_fewer_steps(cantilever):
     """Every mass times (target step / first step)^2: the step is the target (to the
     estimate's tolerance), the run takes that many times fewer steps than the plain one,
     and the tip comes to rest within 0.5% of the Newton answer."""
+    newton, plain, scaled = cantilever("_static"), cantilever(""), cantilever("_mass_scaled")
     target = scaled.deck.solver.mass_scaling.step
     first = plain.dt_history[0][2]
     assert scaled.sim.mass_factor == pytest.approx((target / first) ** 2, rel=1e-3)
@@ -55,12 +49,13 @@ def test_mass_scaling_reaches_the_static_answer_in_fewer_steps(newton, plain, sc
     assert _tip(scaled) == pytest.approx(_tip(newton), rel=5e-3)
 
 
-def test_dynamic_relaxation_stops_at_its_residual_on_the_static_answer(newton, plain, relaxed):
+def test_dynamic_relaxation_stops_at_its_residual_on_the_static_answer(cantilever):
     """Kinetic damping (velocities zeroed at each peak of the kinetic energy), no viscous
     damping: once the load holds, the run stops as the out-of-balance force falls within
     its residual, before the end time and in fewer steps than the plain run, with the tip
     within 0.5% of the Newton answer; the energy taken out is the damping work, and the
     balance holds (internal + kinetic + taken out = external work)."""
+    newton, plain, relaxed = cantilever("_static"), cantilever(""), cantilever("_relaxed")
     record = relaxed.relaxing.record(relaxed.sim)
     tolerance = relaxed.deck.solver.relaxation.residual
     assert record["relaxed_at"] is not None and record["relaxed_at"] < relaxed.deck.solver.end_time

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..bundles import Curves
 from ..curve_tables import EXTRAPOLATION
-from .unknowns import unknowns
+from .equilibrium import Equilibrium
 
 
 def held_from(curves: Curves) -> float:
@@ -34,25 +34,24 @@ class Relaxing:
     """Watches a relaxing run (:class:`shellsim.solver.run.Run`) for rest."""
 
     def __init__(self, run, tolerance: float):
-        self.unknowns = unknowns(run.model)
+        self.equilibrium = Equilibrium(run.sim)
         self.held_from = held_from(run.model.curves)
         self.tolerance = tolerance
         self.residual: float | None = None  # at the last sample looked at, once the curves hold
         self.relaxed_at: float | None = None
 
     def at_rest(self, sim) -> bool:
-        """Whether ``sim`` (:class:`shellsim.solver.simulation.Simulation`) has come to rest:
-        the curves hold and the residual force over the free DOFs is within the tolerance
-        of the larger of the external and internal force norms (over every DOF)."""
-        s = sim.state
-        if s.t < self.held_from:
+        """Whether ``sim`` (:class:`shellsim.solver.simulation.Simulation`, the run's) has
+        come to rest: the curves hold and the residual force over the free DOFs is within
+        the tolerance of the force scale, both as a static step measures them
+        (:class:`shellsim.solver.equilibrium.Equilibrium`)."""
+        if sim.state.t < self.held_from:
             return False
-        free = self.unknowns.gather(self.unknowns.to_local(s.f_ext - s.f_int, s.fr_ext - s.fr_int))
-        scale = max(np.sqrt(np.sum(s.f_ext**2) + np.sum(s.fr_ext**2)),
-                    np.sqrt(np.sum(s.f_int**2) + np.sum(s.fr_int**2)), 1e-300)
-        self.residual = float(np.linalg.norm(free[:self.unknowns.n_free]) / scale)
+        eq = self.equilibrium
+        residual = eq.residual()[:eq.unknowns.n_free]
+        self.residual = float(np.linalg.norm(residual) / max(eq.force_scale(), 1e-300))
         if self.residual <= self.tolerance:
-            self.relaxed_at = float(s.t)
+            self.relaxed_at = float(sim.state.t)
         return self.relaxed_at is not None
 
     def record(self, sim) -> dict:

@@ -32,7 +32,7 @@ from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
-from .timestep import EstimateSchedule
+from .timestep import EstimateSchedule, massless_nodes
 from .valve import VALVE_COLUMNS, ValveMeasures, resolve_valve
 
 #: History samples over a run (fewer when the run has fewer steps).
@@ -296,8 +296,8 @@ def _breakdown_cause(run: Run) -> str:
     if np.isfinite(s.x).all() and np.isfinite(s.d).all() and np.isfinite(s.h).all():
         _watch_quality(run)
     ratios = run.ratios
-    massless = np.flatnonzero(~((s.mt > 0.0) & (s.mr > 0.0)))
-    folding = folding_diagnosis(ratios, run.mesh.x, run.mesh.conn, massless) if ratios is not None else None
+    folding = (folding_diagnosis(ratios, run.mesh.x, run.mesh.conn, massless_nodes(s.mt, s.mr))
+               if ratios is not None else None)
     # a step above the critical one wrecks every shape too: then the step is named as well
     step = _time_step_hint(run) if not folding or run.deck.solver.dt_safety_factor < 1 else ""
     return (f"; {folding}" if folding else "") + step + step_history(run.dt_history)

@@ -200,9 +200,14 @@ def _checked(state, bound: float, vector: np.ndarray) -> tuple[float, np.ndarray
     return bound, vector
 
 
+def massless_nodes(mt: np.ndarray, mr: np.ndarray) -> np.ndarray:
+    """The nodes whose lumped masses mt, mr (n,) are not positive finite numbers (NaN included)."""
+    return np.flatnonzero(~((0.0 < mt) & (mt < np.inf) & (0.0 < mr) & (mr < np.inf)))
+
+
 def _check_masses(mt: np.ndarray, mr: np.ndarray) -> None:
     """Lumped masses (n,) must be positive numbers for M^-1/2 K M^-1/2 to mean anything."""
-    bad = np.flatnonzero(~((0.0 < mt) & (mt < np.inf) & (0.0 < mr) & (mr < np.inf)))  # NaN fails too
+    bad = massless_nodes(mt, mr)
     if bad.size:
         raise NumericalError(
             f"the lumped masses of {bad.size} nodes (first, counting from 1: {(bad[:5] + 1).tolist()}) are not "

@@ -61,22 +61,26 @@ def unknowns(model: Model) -> Unknowns:
     prescribed_axes: list[list[tuple[int, int]]] = [[] for _ in range(n)]
     for p, (node, axis) in enumerate(zip(constraints.prescribed.nodes, constraints.prescribed.axes)):
         prescribed_axes[node].append((p, axis))
-    frames = np.empty((n, 3, 3))
-    index = np.full((n, SLOTS), -1, dtype=np.int64)
-    n_free = 0
-    for node in range(n):
+    # most nodes move freely along x, y and z: only the others' frames are worked out
+    frames = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+    free_translations = np.full(n, 3)
+    supported = ~np.all(np.isclose(constraints.projector, np.eye(3), rtol=0.0, atol=1e-12), axis=(1, 2))
+    for node in np.union1d(np.flatnonzero(supported), constraints.prescribed.nodes):
         values, vectors = np.linalg.eigh(constraints.projector[node])
         free = list(vectors[:, values > 0.5].T)
         moved = [np.eye(3)[axis] for _, axis in prescribed_axes[node]]
         frames[node] = np.asarray(orthonormal(free + moved + list(np.eye(3)))).T  # completed by the fixed rest
-        for k in range(len(free)):
-            index[node, k] = n_free
-            n_free += 1
-        for j in range(2):
-            if constraints.rot_free[node, j] > 0.5:
-                index[node, 3 + j] = n_free
-                n_free += 1
+        free_translations[node] = len(free)
+    # numbered node by node: its free translations, then its free rotations
+    free_rotations = constraints.rot_free > 0.5  # (n, 2)
+    first = np.cumsum(free_translations + free_rotations.sum(axis=1)) - free_translations - free_rotations.sum(axis=1)
+    index = np.full((n, SLOTS), -1, dtype=np.int64)
+    for k in range(3):
+        index[free_translations > k, k] = (first + k)[free_translations > k]
+    index[free_rotations[:, 0], 3] = (first + free_translations)[free_rotations[:, 0]]
+    index[free_rotations[:, 1], 4] = (first + free_translations + free_rotations[:, 0])[free_rotations[:, 1]]
+    n_free = int(free_translations.sum() + free_rotations.sum())
     for node in range(n):
         for k, (p, _) in enumerate(prescribed_axes[node]):
-            index[node, (index[node, :3] >= 0).sum() + k] = n_free + p
+            index[node, free_translations[node] + k] = n_free + p
     return Unknowns(frames=frames, index=index, n_free=n_free, n_known=len(constraints.prescribed.nodes))

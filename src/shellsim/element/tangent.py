@@ -1,14 +1,20 @@
 """Each element's tangent stiffness: the derivative of its nodal forces with respect to its
-45 DOFs, by central differences of the compiled element response, the lanes of a group
-holding copies of one element each moved by one DOF.
+45 DOFs, by differences of the compiled element response, the lanes of a group holding
+copies of one element each moved by one DOF.
 
 DOFs of an element, in the order of its nodes, five per node: the translations along x,
 y and z, then the rotations theta1, theta2 of :func:`shellsim.element.frames.rotate_director`
 in the node's fibre frame. The forces are the same five per node, the rotational ones in
-the (moved) fibre frame, so the derivative holds the frame's turning too. Differences of
-a step h have truncation errors of order h^2 and round-off of order eps / h: on a
-strongly strained element steps of 1e-5 of its size (and 1e-5 rad) left 2e-6 relative,
-1e-6 left 1e-8 (:mod:`shellsim.solver.equilibrium` chooses them).
+the (moved) fibre frame, so the derivative holds the frame's turning too.
+
+Forward differences (the element as it is and each DOF moved forward: 46 evaluations,
+3 groups) cost half of central ones (90, 6 groups). Their truncation error is of order h
+and their round-off of order eps / h, so their best step is near sqrt(eps) of the size:
+against central differences of step 1e-6 (which leave about 1e-8), steps of 3e-9 of the
+size and 3e-9 rad left at most 5e-7 relative on a strongly strained panel of every law
+(1e-8 left up to 1.6e-6 on the exponential laws, 1e-9 up to 6e-7 on a thin hemisphere).
+The static solver takes the forward ones, the central ones are their check
+(:mod:`shellsim.solver.equilibrium` chooses the steps).
 """
 
 from __future__ import annotations
@@ -24,10 +30,11 @@ from .steps import steps_of
 
 #: DOFs of an element: 9 nodes x (3 translations, 2 rotations).
 ELEMENT_DOFS = 45
-#: Lanes per element: each DOF moved forward and back.
+#: Moves of an element's DOFs in :func:`moved_node`'s numbering: each forward and back.
 _MOVES = 2 * ELEMENT_DOFS
-#: Group evaluations per element tangent.
-BATCHES = -(-_MOVES // LANES)
+#: Group evaluations per element tangent by forward differences (the element as it is and
+#: each DOF moved forward) and by central ones (each DOF moved forward and back).
+FORWARD_BATCHES, CENTRAL_BATCHES = -(-(1 + ELEMENT_DOFS) // LANES), -(-_MOVES // LANES)
 
 
 @njit(cache=True, error_model="numpy")
@@ -35,7 +42,7 @@ def moved_node(x, d, e1, move, differences, moved):
     """moved = (xm, dm, e1m) (3,): the position, director and fibre axis of a node (x, d,
     e1 (3,)) moved by DOF ``move // 2`` of its five (forward when even): +-step_u along an
     axis or +-step_r about a fibre axis, differences = (step_u, step_r). Returns the
-    signed step."""
+    signed step taken."""
     step_u, step_r = differences
     xm, dm, e1m = moved
     slot, sign = move // 2, 1.0 if move % 2 == 0 else -1.0
@@ -44,15 +51,18 @@ def moved_node(x, d, e1, move, differences, moved):
     e1m[:] = e1
     if slot < 3:
         xm[slot] += sign * step_u
-        return sign * step_u
+        # the step as the sum rounded it: far from the origin a step of 1e-9 of an
+        # element's size moves it by a few ulps of its coordinate, not by the step
+        return xm[slot] - x[slot]
     rotate_director(dm, e1m, sign * step_r if slot == 3 else 0.0, sign * step_r if slot == 4 else 0.0)
     return sign * step_r
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def element_tangents(rule, body, material, shape, converged, differences, k):
+def element_tangents(rule, body, material, shape, converged, differences, central, k):
     """k (ne, 45, 45): each element's tangent stiffness, the derivative of its internal nodal
-    forces with respect to its DOFs (both in the module's order).
+    forces with respect to its DOFs (both in the module's order), by forward differences,
+    or central ones when ``central``.
 
     shape: the current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
     increments (n, 3) of position and director since the last converged state and the
@@ -67,14 +77,25 @@ def element_tangents(rule, body, material, shape, converged, differences, k):
     for e in prange(ne):
         # e as int64: the parallel loop's own index is unsigned, and typed so it would
         # compile _element_tangent a second time
-        _element_tangent(np.int64(e), path, rule, body, material, shape, dx, dd, stress, step_u, step_r, k[e])
+        _element_tangent(np.int64(e), path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central,
+                         k[e])
+
+
+@njit(cache=True)
+def lane_move(k, central):
+    """The move of an element's k-th evaluation: ``move % 10`` in :func:`moved_node`'s
+    numbering, of the element's node ``move // 10``; or -1 for the element as it is (the
+    forward differences' base, and a batch's spare lanes)."""
+    if central:
+        return k if k < _MOVES else -1
+    return 2 * (k - 1) if 1 <= k <= ELEMENT_DOFS else -1
 
 
 @njit(cache=True, error_model="numpy")
-def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, ke):  # noqa: PLR0913 (prange-bound)
+def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, ke):  # noqa: PLR0913 (prange-bound)
     """ke (45, 45) of element e; arguments as :func:`element_tangents`, ``path`` its
     :class:`~shellsim.element.steps.Steps`. Every lane holds the element as it is; each
-    batch moves one node of each lane and puts it back after."""
+    batch moves one node of each lane (:func:`lane_move`) and puts it back after."""
     conn = body.conn
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
     group, points, scratch = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
@@ -93,35 +114,51 @@ def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_
         _place_node(group, frames, a, -1, (shape.x[node], shape.d[node], shape.e1[node]), (dx[node], dd[node]))
     xm, dm, e1m = np.empty(3), np.empty(3), np.empty(3)
     moves = np.zeros(LANES)
+    forces, base = np.empty(ELEMENT_DOFS), np.zeros(ELEMENT_DOFS)
+    spread = 2.0 if central else 1.0  # the distance between a difference's two evaluations, in steps
     ke[:] = 0.0
-    for batch in range(BATCHES):
+    for batch in range(CENTRAL_BATCHES if central else FORWARD_BATCHES):
         for lane in range(LANES):
-            move = min(batch * LANES + lane, _MOVES - 1)
-            node = conn[e, move // 10]
-            moves[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, (step_u, step_r),
-                                     (xm, dm, e1m))
-            _place_node(group, frames, move // 10, lane, (xm, dm, e1m),
-                        (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
+            move = lane_move(batch * LANES + lane, central)
+            if move >= 0:
+                node = conn[e, move // 10]
+                moves[lane] = moved_node(shape.x[node], shape.d[node], shape.e1[node], move % 10, (step_u, step_r),
+                                         (xm, dm, e1m))
+                _place_node(group, frames, move // 10, lane, (xm, dm, e1m),
+                            (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
         if path.incremental:
             group.stress[:] = base_stress
         # every lane; counted at run time, as the element loop counts, so that one compiled
         # group_response serves both (the literal LANES would compile a second)
         group_response(path, rule, material, group, points, scratch, members.shape[0])
         for lane in range(LANES):
-            move = min(batch * LANES + lane, _MOVES - 1)
-            if batch * LANES + lane < _MOVES:
-                column = move // 2
-                weight = 1.0 / (2.0 * moves[lane])  # + f / 2h forward, - f / 2h back (moves[lane] = -h)
-                for a in range(9):
-                    for i in range(3):
-                        ke[5 * a + i, column] += weight * group.fe[a, i, lane]
-                    for j in range(2):  # in the moved frames
-                        ke[5 * a + 3 + j, column] -= weight * (frames[a, j, 0, lane] * group.ge[a, 0, lane]
-                                                               + frames[a, j, 1, lane] * group.ge[a, 1, lane]
-                                                               + frames[a, j, 2, lane] * group.ge[a, 2, lane])
+            move = lane_move(batch * LANES + lane, central)
+            if move < 0:
+                if batch == 0 and lane == 0 and not central:  # the base, before the lanes that need it
+                    _lane_forces(group, frames, lane, base)
+                continue
+            _lane_forces(group, frames, lane, forces)
+            # (f+ - f) / h forward; f+ / 2h and -f- / 2h central (moves[lane] = -h backward)
+            weight = 1.0 / (spread * moves[lane])
+            for i in range(ELEMENT_DOFS):
+                ke[i, move // 2] += weight * (forces[i] - base[i])
             node = conn[e, move // 10]
             _place_node(group, frames, move // 10, lane, (shape.x[node], shape.d[node], shape.e1[node]),
                         (dx[node], dd[node]))
+
+
+@njit(cache=True, inline="always")
+def _lane_forces(group, frames, lane, forces):
+    """forces (45,): lane ``lane``'s nodal forces in the module's order, the rotational ones
+    from its director forces as :func:`shellsim.element.frames.to_rotational` forms them,
+    in the lane's fibre frames."""
+    for a in range(9):
+        for i in range(3):
+            forces[5 * a + i] = group.fe[a, i, lane]
+        for j in range(2):
+            forces[5 * a + 3 + j] = -(frames[a, j, 0, lane] * group.ge[a, 0, lane]
+                                      + frames[a, j, 1, lane] * group.ge[a, 1, lane]
+                                      + frames[a, j, 2, lane] * group.ge[a, 2, lane])
 
 
 @njit(cache=True, inline="always")

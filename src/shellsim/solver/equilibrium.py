@@ -23,8 +23,12 @@ from . import explicit
 from .simulation import Simulation
 from .unknowns import SLOTS, unknowns
 
-#: Difference steps of the tangent: a share of the mean element size, and radians.
+#: Central-difference steps (the loads' tangents, the elements' check): a share of the mean
+#: element size, and radians.
 STEP_SHARE, STEP_ROTATION = 1e-6, 1e-6
+#: Forward-difference steps of the elements' tangents: near sqrt(eps) (see
+#: :mod:`shellsim.element.tangent`).
+FORWARD_SHARE, FORWARD_ROTATION = 3e-9, 1e-7
 
 
 class Converged:
@@ -52,6 +56,7 @@ class Equilibrium:
         self.converged = Converged(sim)
         conn = model.conn
         size = np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1))
+        self.size = size
         self.step_u = STEP_SHARE * size
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self._t = 0.0
@@ -130,18 +135,20 @@ class Equilibrium:
         return targets - s.x[p.nodes, p.axes] if len(p.nodes) else np.zeros(0)
 
     # --- the tangent -----------------------------------------------------------------
-    def tangent(self) -> sp.csc_matrix:
+    def tangent(self, central: bool = False) -> sp.csc_matrix:
         """K (n_free, size) = d(f_int - f_ext)/du at the state and load time of the last
         :meth:`evaluate` (its increments and pressures): the free rows, the free columns
-        first, then the prescribed ones."""
+        first, then the prescribed ones. The elements' part by forward differences, or by
+        central ones when ``central`` (twice the cost; the check of the forward ones)."""
         model, s, space = self.sim.model, self.sim.state, self.sim.workspace
         c = self.converged.arrays
         shape = s.fields.shape
         if self.incremental:  # the increments are measured with the converged lengths
             shape = shape._replace(h=c["h"])
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
-        self._tangents(model.rule, model.body, model.material, shape, (space.dx, space.dd, c["stress"]),
-                       (self.step_u, STEP_ROTATION), k)
+        steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.size, FORWARD_ROTATION)
+        self._tangents(model.rule, model.body, model.material, shape, (space.dx, space.dd, c["stress"]), steps,
+                       central, k)
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
         if self._turned:
             blocks = self._element_blocks

@@ -19,7 +19,7 @@ from ..bundles import Shape
 from ..deck import Deck
 from ..deck.schema import Solver
 from ..element.groups import group_count
-from ..element.tangent import BATCHES
+from ..element.tangent import FORWARD_BATCHES
 from ..errors import SceneTooLarge
 from ..model import Model
 from ..loads import stable_step
@@ -92,8 +92,8 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
 def static_outlook(model: Model) -> dict:
     """What a static solve will hold and cost per tangent: ``unknowns`` (5 DOF per node,
     supports' included), ``seconds`` per tangent on this machine's threads, ``bytes``."""
-    # an element's tangent takes BATCHES evaluations of a group
-    seconds = BATCHES * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
+    # an element's tangent takes FORWARD_BATCHES evaluations of a group
+    seconds = FORWARD_BATCHES * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
     return {"unknowns": 5 * model.n_nodes, "seconds": seconds, "bytes": memory_bytes(model.n_elements)}
 
 

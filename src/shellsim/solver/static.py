@@ -15,13 +15,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..errors import NumericalError
 from ..loads import passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, _frame, _record, ending, output_times
+from .sparse_lu import SymmetricPatternLU
 
 CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
 #: Modified Newton forms a new tangent when an iteration leaves more than this share of the residual.
@@ -49,7 +49,7 @@ class NotConverged(Exception):
 def _factorised(tangent):
     """The sparse LU factors of ``tangent`` (square)."""
     try:
-        lu = spla.splu(tangent, permc_spec="COLAMD")
+        lu = SymmetricPatternLU(tangent)
     except RuntimeError as error:  # "Factor is exactly singular"
         raise NotConverged(f"the tangent stiffness is singular ({error})") from None
     return lu

@@ -42,6 +42,7 @@ RUN = {
     "test09_aorta_static.toml": {},
     "test10_carotid_slow_M1.toml": {},
     "test10_carotid_slow_M2.toml": {},
+    "pinched_hemisphere_static.toml": {},
 }
 
 #: deck -> where it is checked instead, or why it is not run here.

@@ -55,9 +55,9 @@ class Equilibrium:
         self.incremental = model.material.incremental
         self.converged = Converged(sim)
         conn = model.conn
-        size = np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1))
-        self.size = size
-        self.step_u = STEP_SHARE * size
+        #: the mean element size (a diagonal of each), the unit of the difference steps
+        self.element_size = float(np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1)))
+        self.step_u = STEP_SHARE * self.element_size
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self._t = 0.0
         self._tangents = TypedCall(element_tangents)
@@ -146,7 +146,7 @@ class Equilibrium:
         if self.incremental:  # the increments are measured with the converged lengths
             shape = shape._replace(h=c["h"])
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
-        steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.size, FORWARD_ROTATION)
+        steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.element_size, FORWARD_ROTATION)
         self._tangents(model.rule, model.body, model.material, shape, (space.dx, space.dd, c["stress"]), steps,
                        central, k)
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)

@@ -60,7 +60,7 @@ factor, lu = median_seconds(lambda: SymmetricPatternLU(k))
 colamd, general = median_seconds(lambda: spla.splu(k, permc_spec="COLAMD"))
 rhs = eq.residual()[:n]
 solve, _ = median_seconds(lambda: lu.solve(rhs))
-fill = lu._lu.L.nnz + lu._lu.U.nnz
+fill = lu.entries
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"elements": run.model.n_elements, "unknowns": n, "entries": k.nnz, "forward_s": forward,
                   "central_s": central, "factor_s": factor, "fill": fill, "pivoted": lu.pivoted,

@@ -48,6 +48,11 @@ class SymmetricPatternLU:
             self.pivoted = True
             self._lu = spla.splu(scaled, permc_spec="COLAMD")
 
+    @property
+    def entries(self) -> int:
+        """The entries stored in the factors, L's and U's (the fill, with the matrix's own)."""
+        return self._lu.L.nnz + self._lu.U.nnz
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """x (n,) with matrix @ x = rhs (n,)."""
         return self._scale * self._lu.solve(self._scale * rhs)

@@ -58,9 +58,9 @@ def unknowns(model: Model) -> Unknowns:
     """The :class:`Unknowns` of ``model``'s supports."""
     n = model.n_nodes
     constraints = model.constraints
-    prescribed_axes: list[list[tuple[int, int]]] = [[] for _ in range(n)]
+    prescribed_axes: dict[int, list[tuple[int, int]]] = {}  # node -> its (prescription, axis), in order
     for p, (node, axis) in enumerate(zip(constraints.prescribed.nodes, constraints.prescribed.axes)):
-        prescribed_axes[node].append((p, axis))
+        prescribed_axes.setdefault(int(node), []).append((p, axis))
     # most nodes move freely along x, y and z: only the others' frames are worked out
     frames = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
     free_translations = np.full(n, 3)
@@ -68,19 +68,20 @@ def unknowns(model: Model) -> Unknowns:
     for node in np.union1d(np.flatnonzero(supported), constraints.prescribed.nodes):
         values, vectors = np.linalg.eigh(constraints.projector[node])
         free = list(vectors[:, values > 0.5].T)
-        moved = [np.eye(3)[axis] for _, axis in prescribed_axes[node]]
+        moved = [np.eye(3)[axis] for _, axis in prescribed_axes.get(int(node), [])]
         frames[node] = np.asarray(orthonormal(free + moved + list(np.eye(3)))).T  # completed by the fixed rest
         free_translations[node] = len(free)
     # numbered node by node: its free translations, then its free rotations
     free_rotations = constraints.rot_free > 0.5  # (n, 2)
-    first = np.cumsum(free_translations + free_rotations.sum(axis=1)) - free_translations - free_rotations.sum(axis=1)
+    per_node = free_translations + free_rotations.sum(axis=1)
+    first = np.cumsum(per_node) - per_node
     index = np.full((n, SLOTS), -1, dtype=np.int64)
     for k in range(3):
         index[free_translations > k, k] = (first + k)[free_translations > k]
     index[free_rotations[:, 0], 3] = (first + free_translations)[free_rotations[:, 0]]
     index[free_rotations[:, 1], 4] = (first + free_translations + free_rotations[:, 0])[free_rotations[:, 1]]
-    n_free = int(free_translations.sum() + free_rotations.sum())
-    for node in range(n):
-        for k, (p, _) in enumerate(prescribed_axes[node]):
+    n_free = int(per_node.sum())
+    for node, moves in prescribed_axes.items():
+        for k, (p, _) in enumerate(moves):
             index[node, free_translations[node] + k] = n_free + p
     return Unknowns(frames=frames, index=index, n_free=n_free, n_known=len(constraints.prescribed.nodes))

@@ -8,6 +8,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 import pytest
+from numba import njit
 
 from shellsim import loads
 from shellsim.deck import parse_deck
@@ -56,8 +57,32 @@ def test_every_deck_table_belongs_to_one_kind_and_every_carrier_has_its_parts():
     tags = [table.model_fields["type"].annotation.__args__[0] for table in loads.TABLES]
     assert len(tags) == len(set(tags))
     for kind in loads.CARRIERS:
-        assert callable(kind.add_forces) and callable(kind.empty) and kind.Bundle._fields
+        assert callable(kind.add_forces) and kind.Bundle._fields
     assert loads.Loads._fields == tuple(kind.__name__.rsplit(".", 1)[1] for kind in loads.CARRIERS)
+
+
+def test_a_scene_holds_only_the_kinds_it_uses_or_always_compiles_and_an_absent_kind_is_never_compiled():
+    _, model = forces(deck_text(f'builder = "rectangle"\nlength = {LENGTH}\nwidth = {WIDTH}',
+                                '[[load]]\ntype = "pressure"\nvalue = 1.0\n'))
+    held = {name for name, bundle in model.loads._asdict().items() if bundle is not None}
+    assert held == {"nodal", "pressure"} == {name for name, kind in zip(loads.Loads._fields, loads.CARRIERS)
+                                             if hasattr(kind, "empty")}
+
+    @njit
+    def add_one(t, model, shape, bundle, f):
+        f += bundle
+
+    call = loads._if_present(add_one)
+
+    @njit
+    def compiled_caller(bundle, f):
+        call(0.0, None, None, bundle, (f,))
+
+    f = np.zeros(2)
+    compiled_caller(None, f)
+    assert add_one.signatures == [] and f.tolist() == [0.0, 0.0]
+    compiled_caller(np.ones(2), f)
+    assert len(add_one.signatures) == 1 and f.tolist() == [1.0, 1.0]
 
 
 def test_a_linear_field_gives_the_exact_resultant_and_first_moment(tmp_path):

@@ -11,7 +11,11 @@ A kind is a module of this package with
   nodal forces, a mapped pressure is a follower pressure with values of its own);
 and, when it has kernels of its own,
 - ``Bundle``: a NamedTuple of arrays, every field with the loads along its first axis
-  (the registry concatenates one per table), and ``empty(scene)``, a bundle of none;
+  (the registry concatenates one per table);
+- ``empty(scene)``, a bundle of none, where the kind is compiled into every scene (the
+  everyday loads, nodal and pressure: were each left out where unused, every mix of them
+  would type a model of its own and compile its time loop again); a kind without it is
+  None in a scene that does not use it, and its code is not compiled (:data:`Loads`);
 - compiled ``add_forces(t, model, shape, bundle, f, g)``: its translational and
   director-conjugate forces f, g (n, 3) at time t added;
 - compiled ``add_tangent(t, model, shape, bundle, step_u, step_r, k)`` where its forces
@@ -54,7 +58,8 @@ import time
 from typing import Callable, NamedTuple, Union
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from ..bundles import Body, Curves, Rule, Shape
 from ..compiled_call import TypedCall
@@ -77,15 +82,18 @@ CABLE_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.D
 DECK_KEYS = ("load", "contact", "cable")
 _KIND_OF = {table: kind for kind in KINDS for table in kind.TABLES}
 
-#: Every load of a scene (:class:`shellsim.bundles.Model`'s ``loads``): one bundle per
-#: carrying kind, named after its module.
-Loads = NamedTuple("Loads", [(kind.__name__.rsplit(".", 1)[1], kind.Bundle) for kind in CARRIERS])
+#: Every load of a scene (:class:`shellsim.bundles.Model`'s ``loads``): one field per
+#: carrying kind, named after its module, its bundle; None where the scene has none of it
+#: and the kind has no ``empty``. None types apart from a bundle, so the compiled code of
+#: such a kind is left out of a scene that does not use it (:func:`_chained`): the
+#: contacts' and the cables' kernels are a third of what a scene compiles.
+Loads = NamedTuple("Loads", [(kind.__name__.rsplit(".", 1)[1], Union[kind.Bundle, None]) for kind in CARRIERS])
 
 
 def _with(model, hook: str):
     """(kind, bundle) of every kind of ``model`` that has ``hook`` and loads of its own."""
     return [(kind, bundle) for kind, bundle in zip(CARRIERS, model.loads)
-            if hasattr(kind, hook) and any(len(field) for field in bundle)]
+            if hasattr(kind, hook) and bundle is not None and any(len(field) for field in bundle)]
 
 
 class LoadScene(NamedTuple):
@@ -124,7 +132,8 @@ def build_loads(tables: dict[str, list], scene: LoadScene) -> Loads:
             except MeshError as error:
                 raise MeshError(f"{key}[{i}] ({table.type} on '{table.set}'): {error}") from None
             parts[type(made)].append(made)
-    return Loads(*(_concatenate(parts[kind.Bundle]) if parts[kind.Bundle] else kind.empty(scene) for kind in CARRIERS))
+    return Loads(*(_concatenate(parts[kind.Bundle]) if parts[kind.Bundle]
+                   else kind.empty(scene) if hasattr(kind, "empty") else None for kind in CARRIERS))
 
 
 def _concatenate(bundles: list) -> NamedTuple:
@@ -272,22 +281,40 @@ def measure_names(names: list[str]) -> list[str]:
 
 def _chained(name: str, positions: tuple[int, ...]):
     """A compiled chain(t, model, shape, args) that calls CARRIERS[k].<name>(t, model,
-    shape, model.loads[k], *args) for every k of ``positions``, in order (nothing for
-    none). Compiled code cannot call a function held in a value and still be cached, so
-    the chain is built here, one inlined link per kind."""
+    shape, model.loads[k], *args) for every k of ``positions`` whose bundle is not None,
+    in order (nothing for none). Compiled code cannot call a function held in a value
+    and still be cached, so the chain is built here, one inlined link per kind."""
     if not positions:
         @njit(inline="always")
         def nothing(t, model, shape, args):
             pass
         return nothing
     position, rest = positions[0], _chained(name, positions[1:])
-    kind_function = getattr(CARRIERS[position], name)
+    present = _if_present(getattr(CARRIERS[position], name))
 
     @njit(inline="always")
     def link(t, model, shape, args):
-        kind_function(t, model, shape, model.loads[position], *args)
+        present(t, model, shape, model.loads[position], args)
         rest(t, model, shape, args)
     return link
+
+
+def _if_present(kind_function):
+    """call(t, model, shape, bundle, args): kind_function(t, model, shape, bundle, *args)
+    unless the bundle is None. Compiled, the choice is made by the bundle's type while the
+    caller is typed, and the chosen body inlined: for None nothing of the kind is typed or
+    compiled (numba drops a branch on a field's None only when it is an argument), and no
+    compiled layer of its own copies the kind's code once more."""
+    def call(t, model, shape, bundle, args):
+        if bundle is not None:
+            kind_function(t, model, shape, bundle, *args)
+
+    @overload(call, inline="always")
+    def typed_call(t, model, shape, bundle, args):
+        if isinstance(bundle, types.NoneType):
+            return lambda t, model, shape, bundle, args: None
+        return lambda t, model, shape, bundle, args: kind_function(t, model, shape, bundle, *args)
+    return call
 
 
 def _every_kind_with(name: str):
@@ -299,7 +326,10 @@ _add_every_kind = _every_kind_with("add_forces")
 _add_every_friction = _every_kind_with("add_friction")
 
 
-@njit(cache=True)
+# external_forces and friction_forces are inlined into their callers (the time step, the
+# static solver's applied forces): a compiled layer of their own would copy the kinds' code
+# once more (see shellsim.element.assembly.internal_forces)
+@njit(cache=True, inline="always")
 def external_forces(t, model, shape, f_ext, fr_ext, g):
     """External forces at time t of every load of ``model`` (:class:`shellsim.bundles.Model`)
     on the current ``shape``, friction's apart (:func:`friction_forces`): f_ext (n, 3)
@@ -312,7 +342,7 @@ def external_forces(t, model, shape, f_ext, fr_ext, g):
     to_rotational(g, shape.d, shape.e1, fr_ext)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def friction_forces(t, model, shape, v, w, f_fr, fr_fr, g):
     """The contacts' friction at time t on the current ``shape`` moving at the velocities
     v (n, 3), w (n, 2), after :func:`external_forces` on the same shape (whose contacts

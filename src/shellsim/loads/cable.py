@@ -149,12 +149,6 @@ class Bundle(NamedTuple):
     gravity: np.ndarray
 
 
-def empty(scene) -> Bundle:
-    """A bundle of no cables."""
-    return Bundle(nodes=np.zeros((0, 2), dtype=np.int64), rest=np.zeros(0), area=np.zeros(0), density=np.zeros(0),
-                  law=np.zeros(0, dtype=np.int64), params=np.zeros((0, 3)), gravity=np.zeros((0, 3)))
-
-
 def build(table: Cable, scene) -> Bundle:
     """The elements :func:`extend_mesh` made for ``table``, at rest ``rest_length`` times
     their initial length."""

@@ -45,12 +45,6 @@ class Bundle(NamedTuple):
     curve: np.ndarray
 
 
-def empty(scene) -> Bundle:
-    """No edge pressure."""
-    return Bundle(edges=np.zeros((0, 3), dtype=np.int64), outward=np.zeros(0), value=np.zeros(0),
-                  curve=np.zeros(0, dtype=np.int64))
-
-
 def build(table: EdgePressure, scene) -> Bundle:
     """The loaded edges of one table on ``scene`` (:class:`shellsim.loads.LoadScene`)."""
     edges = scene.mesh.sets[table.set].edges.astype(np.int64)

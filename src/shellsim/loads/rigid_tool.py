@@ -150,12 +150,6 @@ class Bundle(NamedTuple):
 _INTEGERS = ("tool", "shape", "curve", "faces")
 
 
-def empty(scene) -> Bundle:
-    """No rigid tool."""
-    return _repeated(np.zeros(0, dtype=np.int64), tool=-1, shape=0, point=np.zeros(3), direction=np.zeros(3),
-                     radius=0.0, side=1.0, motion=np.zeros(3), curve=-1, faces=(0, 0), penalty=0.1, friction=0.0)
-
-
 def build(table: RigidTool, scene) -> Bundle:
     """The contact nodes of one tool: the nodes of its set (and a surface's triangles)."""
     direction = np.asarray(table.normal if table.shape == "plane" else table.axis or (0.0, 0.0, 1.0), dtype=float)

@@ -130,11 +130,6 @@ class Bundle(NamedTuple):
     entries: np.ndarray
 
 
-def empty(scene) -> Bundle:
-    """No shell contact."""
-    return _passes([], scene.mesh.conn, place=0, table=ShellContact(type="shells", name="none"))
-
-
 def build(table: ShellContact, scene) -> Bundle:
     """One table's contact: the nodes of its set against the faces of the other, and (a
     pair) the other's nodes against the set's faces; each node's faces it overlaps in

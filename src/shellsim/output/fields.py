@@ -150,9 +150,9 @@ class CableMesh(NamedTuple):
 
 def cable_mesh(model: Model) -> CableMesh | None:
     """The cables of ``model`` as line cells; None without any."""
-    ends = model.loads.cable.nodes
-    if not len(ends):
+    if model.loads.cable is None:
         return None
+    ends = model.loads.cable.nodes
     nodes, cells = np.unique(ends, return_inverse=True)
     return CableMesh(points=model.x0[nodes], cells=cells.reshape(ends.shape), nodes=nodes)
 

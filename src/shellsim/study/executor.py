@@ -50,20 +50,24 @@ normal = [0.0, 0.0, 1.0]
 
 
 #: The static solve's kernels (element and follower-pressure tangents) on the same scene.
-WARM_UP_STATIC = WARM_UP_DECK.replace("end_time = 1e-3", 'method = "static"\nend_time = 1e-3') + """
-[[load]]
+#: The everyday scene, loads and no contact: its own time loop (a model's type, and so its
+#: compiled time loop, follows the load kinds it has: :data:`shellsim.loads.Loads`).
+WARM_UP_EVERYDAY = WARM_UP_DECK[:WARM_UP_DECK.index("[[contact]]")] + """[[load]]
 type = "pressure"
 set = "all"
 value = 1e-3
 """
+WARM_UP_STATIC = WARM_UP_EVERYDAY.replace("end_time = 1e-3", 'method = "static"\nend_time = 1e-3')
 
 
 def warm_numba_cache() -> None:
-    """Compile every kernel a run uses, here, once, so workers only load the cache."""
+    """Compile the kernels of the explicit and static runs, here, once, so workers mostly
+    only load the cache: the everyday scene's and every contact kind's (a mix of kinds not
+    warmed compiles its own time loop where it first runs)."""
     from ..deck import parse_deck
     from ..execute import run_scene
 
-    for text in (WARM_UP_DECK, WARM_UP_STATIC):
+    for text in (WARM_UP_DECK, WARM_UP_EVERYDAY, WARM_UP_STATIC):
         with tempfile.TemporaryDirectory() as folder:
             deck = Path(folder) / "warm_up.toml"
             deck.write_text(text)

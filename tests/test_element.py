@@ -9,7 +9,7 @@ import pytest
 
 from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
-from shellsim.element.assembly import assembly, internal_forces, stiffness_product
+from shellsim.element.assembly import ElementLoop, assembly, internal_forces
 from shellsim.element.masses import lumped_masses
 from shellsim.element.frames import rotate_director
 from shellsim.element.sampling import point_tensors
@@ -76,7 +76,7 @@ def internal(model, x, d, e1, h=None, step=None, stress=None):
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=x, d=d, e1=e1, h=model.h0.copy() if h is None else h)
     material = model.material._replace(incremental=step is not None)
-    internal_forces(model._replace(material=material), shape, x * 0 if step is None else step, x * 0, stress, f, fr,
+    internal_forces((model.rule, model.body, material), shape, x * 0 if step is None else step, x * 0, stress, f, fr,
                     assembly(n, model.n_elements))
     return f, fr, stress
 
@@ -89,8 +89,27 @@ def stiffness(model, vu, vr, x=None, stress=None):
     if stress is None:
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
-    stiffness_product(model, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
+    ElementLoop().product(model.structure, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
     return f, fr
+
+
+def test_the_element_loop_from_python_gives_the_time_loops_forces_to_the_bit():
+    """The compiled time loop's parallel loop and the loop Python calls (groups over
+    threads) share the group run and the nodal sums: the same bits, the fibre-length update
+    included (a Mooney-Rivlin tube of 12 elements: one full group and one partial). Over
+    one thread and two: tests/test_threads.py."""
+    _, model = make_model('builder = "tube"\ninner_radius = 1.0\nlength = 1.0', "divisions = { around = 4, axial = 3 }",
+                          material=MOONEY_RIVLIN)
+    x, d, e1 = moved(model, 0.05, RNG.standard_normal((model.n_nodes, 3)), RNG.standard_normal((model.n_nodes, 2)))
+    n = model.n_nodes
+    f, fr, stress = internal(model, x, d, e1, h=model.h0.copy())
+    h, f_loop, fr_loop = model.h0.copy(), np.zeros((n, 3)), np.zeros((n, 2))
+    stress_loop = np.zeros_like(stress)
+    ElementLoop().forces(model.structure, Shape(x=x, d=d, e1=e1, h=h), x * 0, x * 0, stress_loop, f_loop, fr_loop,
+                         assembly(n, model.n_elements))
+    assert np.abs(f).max() > 0.0 and not np.array_equal(h, model.h0)
+    for ours, theirs in ((f_loop, f), (fr_loop, fr), (stress_loop, stress)):
+        np.testing.assert_array_equal(ours, theirs)
 
 
 def initial_shape(model) -> Shape:

@@ -124,7 +124,7 @@ class Model(NamedTuple):
     rule: Rule
     body: Body
     material: Material
-    loads: tuple  # shellsim.loads.Loads: one bundle per load kind, made from the registry
+    loads: tuple  # shellsim.loads.Loads: one bundle per load kind (None: the scene has none), from the registry
     curves: Curves
     constraints: Constraints
     x0: np.ndarray
@@ -139,6 +139,12 @@ class Model(NamedTuple):
     def h0(self) -> np.ndarray:
         """(n,) initial fibre lengths."""
         return self.body.h0
+
+    @property
+    def structure(self) -> tuple:
+        """(rule, body, material): what the element loops take of a model, whose own type
+        changes with the load kinds a scene has."""
+        return self.rule, self.body, self.material
 
     @property
     def conn(self) -> np.ndarray:

@@ -14,6 +14,7 @@ import math
 import os
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -57,6 +58,30 @@ def limit_to_usable_cpus() -> int:
     count = max(1, min(numba.get_num_threads(), usable_cpus()))
     numba.set_num_threads(count)
     return count
+
+
+#: The threads :func:`over_threads` runs ranges on, made at its first use.
+_POOL: ThreadPoolExecutor | None = None
+
+
+def over_threads(run_range: Callable[[int, int], None], count: int) -> None:
+    """``run_range(first, last)`` over 0..count-1, shared out as contiguous ranges over as
+    many threads as the kernels may use now (:func:`kernel_threads`). For a compiled loop
+    that releases the interpreter's lock (``nogil``), called from Python: where no
+    compiled caller needs it, this spares the compiling of a parallel loop."""
+    import numba
+
+    global _POOL
+    threads = max(1, min(numba.get_num_threads(), count))
+    bounds = [count * i // threads for i in range(threads + 1)]
+    if threads > 1 and _POOL is None:
+        _POOL = ThreadPoolExecutor(max_workers=usable_cpus(), thread_name_prefix="shellsim")
+    others = [_POOL.submit(run_range, first, last) for first, last in zip(bounds[1:-1], bounds[2:])]
+    try:
+        run_range(bounds[0], bounds[1])  # the first range on the calling thread
+    finally:
+        for other in others:
+            other.result()
 
 
 @contextmanager

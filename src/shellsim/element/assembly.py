@@ -1,5 +1,6 @@
 """The element loop: groups of elements shared out over the threads, their forces summed
-at the nodes in one fixed order; internal forces and the stiffness product K v.
+at the nodes in one fixed order; internal forces and the stiffness product K v, in the
+time loop (a parallel loop) and from Python (:class:`ElementLoop`).
 
 Results are the same to the last bit for any number of threads: each group writes only
 its own elements' slots of an :class:`Assembly` and of the stresses, and each node then
@@ -17,6 +18,8 @@ from .frames import director_increments, to_rotational
 from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_arrays, group_response
 from .steps import steps_of
+from ..compiled_call import TypedCall
+from ..threads import over_threads
 
 
 class Assembly(NamedTuple):
@@ -71,13 +74,10 @@ def _all_elements(steps, rule, body, material, shape, ux, ud, stress, f, fr, par
     for c in prange(chunks):
         _group_run(c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
                    parts)
-    _gather_at_nodes(body, parts, f)
-    to_rotational(parts.g, shape.d, shape.e1, fr)
-    if steps.update_lengths:
-        _update_fibre_lengths(body, parts, shape.h, steps.convected)
+    _after_groups(steps, body, shape, parts, f, fr)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (prange-bound)
     """The responses of groups start..stop-1 into their elements' slots of ``parts`` and
     ``stress``; arguments as :func:`_all_elements`. Element volumes and mean stretches are
@@ -122,6 +122,16 @@ def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, 
 
 
 @njit(cache=True, error_model="numpy")
+def _after_groups(steps, body, shape, parts, f, fr):
+    """What follows the groups' responses in ``parts``: their nodal sums f (n, 3) and fr
+    (n, 2), and the fibre lengths of ``shape`` updated when ``steps`` say so."""
+    _gather_at_nodes(body, parts, f)
+    to_rotational(parts.g, shape.d, shape.e1, fr)
+    if steps.update_lengths:
+        _update_fibre_lengths(body, parts, shape.h, steps.convected)
+
+
+@njit(cache=True, error_model="numpy")
 def _gather_at_nodes(body, parts, f):
     """The nodal sums of the element forces in ``parts`` (:class:`Assembly`), each node's
     slots in ascending order: f (n, 3) from fe, parts.g from ge."""
@@ -151,14 +161,20 @@ def _update_fibre_lengths(body, parts, h, incremental):
             h[node] = (h[node] if incremental else body.h0[node]) * weighted / weights
 
 
-@njit(cache=True, error_model="numpy")
-def internal_forces(model, shape, dx, dd, stress, f, fr, parts):
-    """Internal forces of all elements at the current configuration.
+# inlined into the time step (shellsim.solver.explicit.forces): a compiled layer of its own
+# would copy, optimise and emit the whole element path once more (numba links each callee's
+# code into its caller's), for a function that only passes its arguments on
+@njit(cache=True, error_model="numpy", inline="always")
+def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
+    """Internal forces of all elements at the current configuration, in the time loop
+    (from Python: :meth:`ElementLoop.forces`, the same in every bit).
 
     Parameters
     ----------
-    model : :class:`shellsim.bundles.Model`: its rule, body and material (whose path,
-        :class:`~shellsim.bundles.Material`, says how). In the total formulation the stress follows
+    structure : (rule, body, material) of a :class:`shellsim.bundles.Model` (its
+        ``structure``; the material's path, :class:`~shellsim.bundles.Material`, says how.
+        Not the model: its type changes with the load kinds a scene has, and this would
+        compile once for each). In the total formulation the stress follows
         from the total deformation (Almansi strain, thesis Eq 3.1 and 3.22); in the
         incremental one (``material.incremental``) the stress in the lamina frame gains
         C~ times the strain increment of the last step (Eq 3.2).
@@ -171,25 +187,48 @@ def internal_forces(model, shape, dx, dd, stress, f, fr, parts):
     """
     # a run-time boolean: a constant would type as a literal and compile the whole element
     # path once more for the product (half of a cold start's compiling)
-    material = model.material
-    _all_elements(steps_of(material, np.bool_(False)), model.rule, model.body, material, shape, dx, dd, stress, f, fr,
-                  parts)
+    rule, body, material = structure
+    _all_elements(steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress, f, fr, parts)
 
 
-@njit(cache=True, error_model="numpy")
-def stiffness_product(model, shape, stress, vu, vr, f, fr, parts):
-    """Tangent stiffness times a DOF vector, K v, without forming K: the material part
-    K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
-    Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
-    thesis leaves out but a membrane stretched to large strain needs (Test 8: the step
-    from K_L alone was too long on refined meshes).
+class ElementLoop:
+    """The element loop as Python calls it (a run's first forces, the static solver, the
+    critical step's K v products): the groups shared out over threads
+    (:func:`shellsim.threads.over_threads`) by the compiled group run, which releases the
+    interpreter's lock, then summed at the nodes as the time loop sums them, so that the
+    results are the same to the bit. It spares compiling the time loop's parallel loop
+    where no time loop runs: numba wraps three compiled layers around a parallel loop's
+    body, each with the whole element path in it. One per model: each call keeps the
+    argument types of its first."""
 
-    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
-    fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
-    loop's: it is scratch between steps).
-    """
-    vd = np.empty((shape.x.shape[0], 3))
-    director_increments(vr, shape.d, shape.e1, vd)
-    material = model.material
-    _all_elements(steps_of(material, np.bool_(True)), model.rule, model.body, material, shape, vu, vd, stress, f, fr,
-                  parts)
+    def __init__(self):
+        self._steps, self._groups, self._after = TypedCall(steps_of), TypedCall(_group_run), TypedCall(_after_groups)
+
+    def forces(self, structure, shape, dx, dd, stress, f, fr, parts) -> None:
+        """As :func:`internal_forces`."""
+        self._evaluate(False, structure, shape, (dx, dd), stress, (f, fr), parts)
+
+    def product(self, structure, shape, stress, vu, vr, f, fr, parts) -> None:
+        """Tangent stiffness times a DOF vector, K v, without forming K: the material part
+        K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
+        Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which
+        the thesis leaves out but a membrane stretched to large strain needs (Test 8: the
+        step from K_L alone was too long on refined meshes).
+
+        vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
+        fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
+        loop's: it is scratch between steps).
+        """
+        vd = np.empty((shape.x.shape[0], 3))
+        director_increments(vr, shape.d, shape.e1, vd)
+        self._evaluate(True, structure, shape, (vu, vd), stress, (f, fr), parts)
+
+    def _evaluate(self, product: bool, structure, shape, increments, stress, forces, parts) -> None:
+        """The forces (f, fr) of the element response at ``increments`` (ux, ud), or the
+        product's when ``product``."""
+        rule, body, material = structure
+        steps = self._steps(material, np.bool_(product))
+        ux, ud = increments
+        over_threads(lambda first, last: self._groups(first, last, steps, rule, body, material, shape, ux, ud, stress,
+                                                      parts), group_count(len(body.conn)))
+        self._after(steps, body, shape, parts, *forces)

@@ -20,7 +20,7 @@ The static solver takes the forward ones, the central ones are their check
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from .frames import cross, rotate_director
 from ..lanes import LANES
@@ -58,27 +58,30 @@ def moved_node(x, d, e1, move, differences, moved):
     return sign * step_r
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def element_tangents(rule, body, material, shape, converged, differences, central, k):
-    """k (ne, 45, 45): each element's tangent stiffness, the derivative of its internal nodal
-    forces with respect to its DOFs (both in the module's order), by forward differences,
-    or central ones when ``central``.
+# a serial loop that releases the interpreter's lock, shared out over threads by its caller
+# (shellsim.threads.over_threads): a parallel loop here cost a quarter of a static run's
+# first compiling, in the three compiled layers numba wraps around a parallel loop's body
+@njit(cache=True, nogil=True, error_model="numpy")
+def element_tangents(structure, shape, converged, differences, central, elements, k):
+    """k (ne, 45, 45): the tangent stiffness of elements ``elements`` = (first, last),
+    first..last-1: the derivative of each one's internal nodal forces with respect to its
+    DOFs (both in the module's order), by forward differences, or central ones when
+    ``central``. The other elements' blocks are left as they are.
 
-    shape: the current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
+    structure: (rule, body, material) of a :class:`~shellsim.bundles.Model`; shape: the
+    current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
     increments (n, 3) of position and director since the last converged state and the
     stress (ne, nq, nt, 5) there (read by an incremental material only); differences:
     (step_u [length], step_r [rad]), the difference steps. The fibre lengths are held
     (their update follows the deformation one evaluation behind).
     """
-    ne = body.conn.shape[0]
+    rule, body, material = structure
     dx, dd, stress = converged
     step_u, step_r = differences
     path = steps_of(material, np.bool_(False))
-    for e in prange(ne):
-        # e as int64: the parallel loop's own index is unsigned, and typed so it would
-        # compile _element_tangent a second time
-        _element_tangent(np.int64(e), path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central,
-                         k[e])
+    first, last = elements
+    for e in range(first, last):
+        _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, k[e])
 
 
 @njit(cache=True)
@@ -91,8 +94,10 @@ def lane_move(k, central):
     return 2 * (k - 1) if 1 <= k <= ELEMENT_DOFS else -1
 
 
-@njit(cache=True, error_model="numpy")
-def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, ke):  # noqa: PLR0913 (prange-bound)
+# inlined into its one caller: a compiled layer of its own would optimise and emit the
+# whole element response once more (see shellsim.element.assembly.internal_forces)
+@njit(cache=True, error_model="numpy", inline="always")
+def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, ke):  # noqa: PLR0913 (flat bundles)
     """ke (45, 45) of element e; arguments as :func:`element_tangents`, ``path`` its
     :class:`~shellsim.element.steps.Steps`. Every lane holds the element as it is; each
     batch moves one node of each lane (:func:`lane_move`) and puts it back after."""

@@ -19,7 +19,7 @@ from ..element.tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
 from ..curve_tables import factor
 from ..loads import LoadTangents
-from . import explicit
+from ..threads import over_threads
 from .simulation import Simulation
 from .unknowns import SLOTS, unknowns
 
@@ -62,7 +62,6 @@ class Equilibrium:
         self._t = 0.0
         self._tangents = TypedCall(element_tangents)
         self._load_tangents = LoadTangents(model)
-        self._forces = TypedCall(explicit.forces)
         self._pattern()
 
     def _pattern(self) -> None:
@@ -101,7 +100,7 @@ class Equilibrium:
             np.subtract(s.d, c["d"], out=space.dd)
             s.stress[:] = c["stress"]
             s.h[:] = c["h"]
-        self._forces(float(t), self.sim.model, s.fields, space)
+        self.sim.compute_forces(t)
 
     def residual(self) -> np.ndarray:
         """f_ext - f_int over the unknowns (size,) from the last :meth:`evaluate`."""
@@ -147,8 +146,9 @@ class Equilibrium:
             shape = shape._replace(h=c["h"])
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
         steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.element_size, FORWARD_ROTATION)
-        self._tangents(model.rule, model.body, model.material, shape, (space.dx, space.dd, c["stress"]), steps,
-                       central, k)
+        converged = (space.dx, space.dd, c["stress"])
+        over_threads(lambda first, last: self._tangents(model.structure, shape, converged, steps, central, (first, last),
+                                                        k), len(k))
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
         if self._turned:
             blocks = self._element_blocks

@@ -61,12 +61,22 @@ def workspace(model) -> Workspace:
                      f_fr=np.zeros((m, 3)), fr_fr=np.zeros((m, 2)), relax=np.zeros(2))
 
 
-@njit(cache=True)
+# inlined into the time loop (see shellsim.element.assembly.internal_forces); from Python,
+# Simulation.compute_forces
+@njit(cache=True, inline="always")
 def forces(t, model, fields, space):
     """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
     forces of the incremental formulation take the last step's increments from ``space``."""
-    internal_forces(model, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int, space.parts)
+    internal_forces((model.rule, model.body, model.material), fields.shape, space.dx, space.dd, fields.stress,
+                    fields.f_int, fields.fr_int, space.parts)
+    applied_forces(t, model, fields, space)
+
+
+@njit(cache=True, inline="always")
+def applied_forces(t, model, fields, space):
+    """The external forces at time t on the shape of ``fields``, into its f_ext (n, 3) and
+    fr_ext (n, 2): every load's, and the contacts' friction at its velocities."""
     external_forces(t, model, fields.shape, fields.f_ext, fields.fr_ext, space.g)
     if space.friction:
         friction_forces(t, model, fields.shape, fields.v, fields.w, space.f_fr, space.fr_fr, space.g)

@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..bundles import Fields, Shape
-from ..element.assembly import stiffness_product
+from ..element.assembly import ElementLoop
 from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
 from ..compiled_call import TypedCall
@@ -46,7 +46,7 @@ class Compiled(NamedTuple):
 
     advance: TypedCall
     masses: TypedCall
-    stiffness: TypedCall
+    applied_forces: TypedCall
 
 
 class Simulation:
@@ -64,7 +64,9 @@ class Simulation:
             energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
-                                 stiffness=TypedCall(stiffness_product))
+                                 applied_forces=TypedCall(explicit.applied_forces))
+        #: the element loop called from Python (forces, K v products)
+        self.elements = ElementLoop()
         self._eigenvector: np.ndarray | None = None
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
@@ -115,7 +117,16 @@ class Simulation:
         (with no step increment: an incremental stress stays as it is)."""
         self.workspace.dx[:] = 0.0
         self.workspace.dd[:] = 0.0
-        explicit.forces(self.state.t, self.model, self.state.fields, self.workspace)
+        self.compute_forces(self.state.t)
+
+    def compute_forces(self, t: float) -> None:
+        """Internal and external forces and the stresses at the current shape and load time
+        t, the incremental formulation's from the increments in the workspace: what the
+        time loop's :func:`~shellsim.solver.explicit.forces` computes, from Python."""
+        m, fields, space = self.model, self.state.fields, self.workspace
+        self.elements.forces(m.structure, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int,
+                             space.parts)
+        self.compiled.applied_forces(float(t), m, fields, space)
 
     def advance(self, t_stop: float, dt: float, max_steps: int) -> int:
         """Step with ``dt`` until ``t_stop`` (landing on it) or ``max_steps``; returns the

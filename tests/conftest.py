@@ -47,12 +47,13 @@ def pytest_configure(config):
     if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
         import time
 
-        from shellsim.compile_watch import FIRST_RUN_NOTE, watching_compiles
+        from shellsim.compile_watch import watching_compiles
         from shellsim.study.executor import warm_numba_cache
 
         start = time.perf_counter()
         compiled = []
-        with watching_compiles(lambda name: compiled or print(f"compiling the kernels ({FIRST_RUN_NOTE})", flush=True),
+        note = "compiling the kernels of three scenes, once for this version: about 4 minutes on 2 idle cores"
+        with watching_compiles(lambda name: compiled or print(note, flush=True),
                                lambda name, seconds: compiled.append(name)):
             warm_numba_cache()
         if compiled:

@@ -14,9 +14,10 @@ from contextlib import contextmanager
 
 from numba.core import event
 
-#: What a user is told when the kernels compile: once per version, and how long in all
-#: (warming the cache, study.executor.warm_numba_cache, from empty: docs/verification.md).
-FIRST_RUN_NOTE = "once for this version of shellsim: about 3 minutes in all on 2 idle cores"
+#: What a user is told when a scene's kernels compile: once per version, and how long for
+#: a first scene from an empty cache (docs/verification.md; a later scene with other load
+#: or contact kinds compiles its own time loop, a fraction of that).
+FIRST_RUN_NOTE = "once for this version of shellsim: about a minute and a half for a first scene on 2 idle cores"
 #: Kernels that compile longer than this [s] are named when done; the rest pass quietly.
 WORTH_TELLING = 5.0
 

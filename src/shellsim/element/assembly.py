@@ -1,6 +1,6 @@
 """The element loop: groups of elements shared out over the threads, their forces summed
 at the nodes in one fixed order; internal forces and the stiffness product K v, in the
-time loop (a parallel loop) and from Python (:class:`ElementLoop`).
+time loop (a parallel loop) and, for the forces, from Python (:class:`ElementLoop`).
 
 Results are the same to the last bit for any number of threads: each group writes only
 its own elements' slots of an :class:`Assembly` and of the stresses, and each node then
@@ -191,44 +191,43 @@ def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
     _all_elements(steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress, f, fr, parts)
 
 
+@njit(cache=True, error_model="numpy")
+def stiffness_product(structure, shape, stress, vu, vr, f, fr, parts):
+    """Tangent stiffness times a DOF vector, K v, without forming K: the material part
+    K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
+    Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
+    thesis leaves out but a membrane stretched to large strain needs (Test 8: the step
+    from K_L alone was too long on refined meshes).
+
+    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
+    fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
+    loop's: it is scratch between steps). The critical step's estimates of an explicit
+    run call it thousands of times, so it is one compiled call on the time loop's
+    parallel loop, compiled for that run anyway.
+    """
+    vd = np.empty((shape.x.shape[0], 3))
+    director_increments(vr, shape.d, shape.e1, vd)
+    rule, body, material = structure
+    _all_elements(steps_of(material, np.bool_(True)), rule, body, material, shape, vu, vd, stress, f, fr, parts)
+
+
 class ElementLoop:
-    """The element loop as Python calls it (a run's first forces, the static solver, the
-    critical step's K v products): the groups shared out over threads
+    """The internal forces as Python calls them where no time loop runs (the static
+    solver's, and a run's first): the groups shared out over threads
     (:func:`shellsim.threads.over_threads`) by the compiled group run, which releases the
     interpreter's lock, then summed at the nodes as the time loop sums them, so that the
-    results are the same to the bit. It spares compiling the time loop's parallel loop
-    where no time loop runs: numba wraps three compiled layers around a parallel loop's
-    body, each with the whole element path in it. One per model: each call keeps the
-    argument types of its first."""
+    results are the same to the bit. It spares a static scene compiling the time loop's
+    parallel loop: numba wraps three compiled layers around a parallel loop's body, each
+    with the whole element path in it. One per model: each call keeps the argument types
+    of its first."""
 
     def __init__(self):
         self._steps, self._groups, self._after = TypedCall(steps_of), TypedCall(_group_run), TypedCall(_after_groups)
 
     def forces(self, structure, shape, dx, dd, stress, f, fr, parts) -> None:
         """As :func:`internal_forces`."""
-        self._evaluate(False, structure, shape, (dx, dd), stress, (f, fr), parts)
-
-    def product(self, structure, shape, stress, vu, vr, f, fr, parts) -> None:
-        """Tangent stiffness times a DOF vector, K v, without forming K: the material part
-        K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
-        Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which
-        the thesis leaves out but a membrane stretched to large strain needs (Test 8: the
-        step from K_L alone was too long on refined meshes).
-
-        vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
-        fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
-        loop's: it is scratch between steps).
-        """
-        vd = np.empty((shape.x.shape[0], 3))
-        director_increments(vr, shape.d, shape.e1, vd)
-        self._evaluate(True, structure, shape, (vu, vd), stress, (f, fr), parts)
-
-    def _evaluate(self, product: bool, structure, shape, increments, stress, forces, parts) -> None:
-        """The forces (f, fr) of the element response at ``increments`` (ux, ud), or the
-        product's when ``product``."""
         rule, body, material = structure
-        steps = self._steps(material, np.bool_(product))
-        ux, ud = increments
-        over_threads(lambda first, last: self._groups(first, last, steps, rule, body, material, shape, ux, ud, stress,
+        steps = self._steps(material, np.bool_(False))
+        over_threads(lambda first, last: self._groups(first, last, steps, rule, body, material, shape, dx, dd, stress,
                                                       parts), group_count(len(body.conn)))
-        self._after(steps, body, shape, parts, *forces)
+        self._after(steps, body, shape, parts, f, fr)

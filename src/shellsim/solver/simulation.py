@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..bundles import Fields, Shape
-from ..element.assembly import ElementLoop
+from ..element.assembly import ElementLoop, stiffness_product
 from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
 from ..compiled_call import TypedCall
@@ -46,6 +46,7 @@ class Compiled(NamedTuple):
 
     advance: TypedCall
     masses: TypedCall
+    stiffness: TypedCall
     applied_forces: TypedCall
 
 
@@ -64,8 +65,9 @@ class Simulation:
             energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
+                                 stiffness=TypedCall(stiffness_product),
                                  applied_forces=TypedCall(explicit.applied_forces))
-        #: the element loop called from Python (forces, K v products)
+        #: the internal forces called from Python
         self.elements = ElementLoop()
         self._eigenvector: np.ndarray | None = None
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)

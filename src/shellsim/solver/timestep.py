@@ -130,7 +130,7 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None,
         z = np.asarray(z).ravel()
         vu = np.einsum("nij,nj->ni", projector, z[: 3 * n].reshape(n, 3) * inv_sqrt_t[:, None])
         vr = z[3 * n:].reshape(n, 2) * inv_sqrt_r[:, None] * rot_free
-        sim.elements.product(m.structure, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts)
+        sim.compiled.stiffness(m.structure, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts)
         out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * rot_free * inv_sqrt_r[:, None]
         return np.concatenate([out_u.ravel(), out_r.ravel()])

@@ -61,9 +61,9 @@ def workspace(model) -> Workspace:
                      f_fr=np.zeros((m, 3)), fr_fr=np.zeros((m, 2)), relax=np.zeros(2))
 
 
-# inlined into the time loop (see shellsim.element.assembly.internal_forces); from Python,
-# Simulation.compute_forces
-@njit(cache=True, inline="always")
+# only ever inlined into the time loop (see shellsim.element.assembly.internal_forces), so
+# never compiled, nor cached, on its own; from Python: Simulation.compute_forces
+@njit(inline="always")
 def forces(t, model, fields, space):
     """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -23,6 +24,7 @@ from shellsim.cli import app, sigterm_as_interrupt
 from shellsim.deck import load_deck, parse_deck
 from shellsim.element.shape import gauss_rule
 from shellsim.errors import OutputError
+from shellsim.output.encoding import Encoding, symmetric_tensors
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
 from shellsim.output.series import check_space
 from shellsim.solver.run import Listener, integrate, output_times
@@ -50,6 +52,7 @@ value = [0.0, 1.0]
 [output]
 times = [0.1, 0.25]
 formats = ["xdmf", "vtu"]
+precision = "double"
 fields = {ALL_FIELDS}
 
 [[output.probe]]
@@ -82,9 +85,9 @@ def test_xdmf_series_has_one_time_per_frame_and_the_sub_cell_mesh(plate_run):
     assert point_data["displacement"].shape == (ne * 16, 3)
     assert point_data["director"].shape == (ne * 16, 3) and point_data["thickness"].shape == (ne * 16,)
     for name in ("cauchy_stress", "lamina_stress", "green_lagrange_strain"):
-        assert cell_data[name][0].shape == (ne * 9, 9) and point_data[name + "_nodal"].shape == (ne * 16, 9)
+        assert cell_data[name][0].shape == (ne * 9, 6) and point_data[name + "_nodal"].shape == (ne * 16, 6)
     assert cell_data["pressure_band"][0].shape == (ne * 9,)
-    sigma = cell_data["cauchy_stress"][0].reshape(-1, 3, 3)
+    sigma = symmetric_tensors(cell_data["cauchy_stress"][0])
     np.testing.assert_allclose(cell_data["pressure_band"][0], -np.trace(sigma, axis1=1, axis2=2) / 3, rtol=1e-12)
     # bending: the tip has moved, and the frame at t = 0 is the undeformed plate
     assert abs(point_data["displacement"][:, 2]).max() > 1e-3
@@ -108,6 +111,128 @@ def test_vtu_frames_hold_the_same_arrays_as_the_xdmf_series(plate_run):
     np.testing.assert_array_equal(grid.point_data["displacement"], point_data["displacement"])
     np.testing.assert_array_equal(grid.cell_data["cauchy_stress"], cell_data["cauchy_stress"][0])
     np.testing.assert_array_equal(grid.cell_data["pressure_band"], cell_data["pressure_band"][0])
+
+
+def _written_both_ways(folder: Path, encoding: Encoding) -> tuple[Path, dict]:
+    """A 2 x 2 grid of quads with a smooth vector and tensor field over two frames, written
+    as XDMF and VTU with ``encoding`` into ``folder``; returns the folder and the last
+    frame's fields as given."""
+    from types import SimpleNamespace
+
+    from shellsim.output.vtu import VtuSeries
+    from shellsim.output.xdmf import XdmfSeries
+
+    x, y = np.meshgrid(np.linspace(0.0, 1.0, 3), np.linspace(0.0, 1.0, 3))
+    points = np.column_stack([x.ravel(), y.ravel(), np.zeros(9)])
+    cells = np.array([[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]])
+    mesh = SimpleNamespace(points=points, cells=cells, cell_type="quad")
+    folder.mkdir()
+    series = [XdmfSeries(folder, mesh, encoding), VtuSeries(folder, mesh, encoding)]
+    for t in (0.0, 0.1):
+        fields = ({"displacement": t * np.sin(points + 1.0 / 3.0)},
+                  {"cauchy_stress": t * np.cos(np.arange(24.0).reshape(4, 6) / 7.0), "pressure_band": t * np.ones(4)})
+        for one in series:
+            one.write(t, *fields)
+    for one in series:
+        one.close()
+    return folder, fields
+
+
+@pytest.mark.parametrize("precision, float_type", [("single", np.float32), ("double", np.float64)])
+def test_series_store_their_numbers_at_the_decks_precision_compressed_or_not(tmp_path, precision, float_type):
+    """Both formats hold the values rounded to the asked precision, exactly, compressed or
+    not; compressed, the HDF5 datasets are gzip'ed and the VTU zlib'ed."""
+    import h5py
+
+    for compress in (True, False):
+        encoding = Encoding.of(parse_deck(PLATE.replace('precision = "double"', f'precision = "{precision}"\n'
+                                                        f'compress = {str(compress).lower()}')).output)
+        assert encoding == Encoding(float_type, compress)
+        folder, (point_data, cell_data) = _written_both_ways(tmp_path / f"{precision}_{compress}", encoding)
+        reader = meshio.xdmf.TimeSeriesReader(folder / "results.xdmf")
+        reader.read_points_cells()
+        _, xdmf_points, xdmf_cells = reader.read_data(1)
+        vtu = meshio.read(folder / "frames" / "results_0001.vtu")
+        for read_points, read_cells in ((xdmf_points, xdmf_cells), (vtu.point_data, vtu.cell_data)):
+            assert read_points["displacement"].dtype == float_type
+            np.testing.assert_array_equal(read_points["displacement"], point_data["displacement"].astype(float_type))
+            np.testing.assert_array_equal(read_cells["cauchy_stress"][0], cell_data["cauchy_stress"].astype(float_type))
+        with h5py.File(folder / "results.h5") as stored:
+            assert stored["frames/1/displacement"].compression == ("gzip" if compress else None)
+        assert (b"vtkZLibDataCompressor" in (folder / "frames" / "results_0001.vtu").read_bytes()) == compress
+
+
+def test_each_xdmf_frame_names_its_own_mesh_and_tensors_have_six_components(tmp_path):
+    """No mesh grid beside the frames (ParaView's legacy XDMF reader showed one as an
+    undeformed copy): the domain holds only the temporal collection, each frame points at
+    the one stored topology and geometry, and a symmetric tensor is a six-column Matrix,
+    whose components every ParaView reader names XX, YY, ZZ, XY, YZ, XZ."""
+    folder, _ = _written_both_ways(tmp_path / "out", Encoding())
+    (collection,) = ET.parse(folder / "results.xdmf").getroot().find("Domain")
+    assert collection.get("CollectionType") == "Temporal"
+    for frame in collection:
+        assert frame.find("Topology/DataItem").text == "results.h5:/mesh/cells"
+        assert frame.find("Geometry/DataItem").text == "results.h5:/mesh/points"
+        stress = frame.find("Attribute[@Name='cauchy_stress']")
+        assert stress.get("AttributeType") == "Matrix" and stress.find("DataItem").get("Dimensions") == "4 6"
+    assert [float(frame.find("Time").get("Value")) for frame in collection] == [0.0, 0.1]
+
+
+def test_a_symmetric_tensor_is_written_in_paraviews_order_and_rebuilt():
+    """Six components in VTK's order (xx, yy, zz, xy, yz, xz: the names ParaView gives a
+    six-component array), and back to the same tensor."""
+    from shellsim.output.encoding import symmetric_columns
+
+    tensor = np.array([[1.0, 4.0, 6.0], [4.0, 2.0, 5.0], [6.0, 5.0, 3.0]])
+    np.testing.assert_array_equal(symmetric_columns(tensor), [1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    np.testing.assert_array_equal(symmetric_tensors(symmetric_columns(np.stack([tensor, 2 * tensor]))),
+                                  np.stack([tensor, 2 * tensor]))
+
+
+PARAVIEW_SCRIPT = """
+import json, sys
+from paraview.simple import PVDReader, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
+folder = sys.argv[1]
+seen = {}
+for name, reader in (("XDMF Reader", lambda: XDMFReader(FileNames=[folder + "/results.xdmf"])),
+                     ("Xdmf3ReaderS", lambda: Xdmf3ReaderS(FileName=[folder + "/results.xdmf"])),
+                     ("Xdmf3ReaderT", lambda: Xdmf3ReaderT(FileName=[folder + "/results.xdmf"])),
+                     ("PVD", lambda: PVDReader(FileName=folder + "/results.pvd"))):
+    source = reader()
+    times = list(source.TimestepValues)
+    frames = []
+    for t in times:
+        source.UpdatePipeline(t)
+        info = source.GetDataInformation()
+        arrays = {a.Name: [a.GetComponentName(c) for c in range(a.GetNumberOfComponents())]
+                  for arrays in (source.PointData, source.CellData) for a in arrays.values()}
+        frames.append({"points": info.GetNumberOfPoints(), "cells": info.GetNumberOfCells(), "arrays": arrays,
+                       "largest_displacement": source.PointData["displacement"].GetRange(-1)[1]})
+    seen[name] = {"times": times, "frames": frames}
+print(json.dumps(seen))
+"""
+
+
+@pytest.mark.skipif(shutil.which("pvpython") is None, reason="ParaView's pvpython is not installed")
+def test_paraview_reads_every_frame_at_its_time_with_every_field_named(plate_run):
+    """ParaView's XDMF readers (legacy and both Xdmf3) and its PVD reader show each frame at
+    its time, on the mesh alone (no second, undeformed copy), moving, with every field and
+    a tensor's components named."""
+    result = subprocess.run(["pvpython", "-c", PARAVIEW_SCRIPT, str(plate_run)], capture_output=True, text=True,
+                            timeout=300)
+    assert result.returncode == 0, result.stderr
+    seen = json.loads(result.stdout.strip().splitlines()[-1])
+    assert len(seen) == 4
+    ne = 4
+    for reader, found in seen.items():
+        assert found["times"] == pytest.approx([0.0, 0.1, 0.25, 0.5], abs=1e-12), reader
+        moved = [frame["largest_displacement"] for frame in found["frames"]]
+        assert moved[0] == 0.0 and moved[1] < moved[2] < moved[3], reader
+        for frame in found["frames"]:
+            assert (frame["points"], frame["cells"]) == (ne * 16, ne * 9), reader
+            assert set(frame["arrays"]) == {"displacement", "director", "thickness", *(
+                f"{name}{nodal}" for name in ALL_FIELDS[3:] for nodal in ("", "_nodal"))}, reader
+            assert frame["arrays"]["cauchy_stress"] == ["XX", "YY", "ZZ", "XY", "YZ", "XZ"], reader
 
 
 def test_resolved_deck_loads_back_to_the_same_scene_with_the_version(plate_run):
@@ -153,7 +278,7 @@ def test_sub_cells_carry_their_gauss_points_values_and_the_nodal_version_is_exac
     assert inside.all()
     np.testing.assert_allclose(cell_data["green_lagrange_strain"][:, 0], exx(gauss_x), rtol=1e-10)
     np.testing.assert_allclose(point_data["green_lagrange_strain_nodal"][:, 0], exx(mesh.points[:, 0]), rtol=1e-9, atol=1e-11 * exx(2.0))
-    assert np.abs(cell_data["green_lagrange_strain"][:, [4, 8]]).max() < 1e-14  # nothing along y or z
+    assert np.abs(cell_data["green_lagrange_strain"][:, [1, 2]]).max() < 1e-14  # nothing along y or z
 
 
 def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_view():
@@ -167,14 +292,14 @@ def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_v
     nt = len(run.model.rule.tz)
     _, solid = frame_fields(run.sim, output_mesh(run.model, solid=True), ["cauchy_stress", "von_mises"])
     _, shell = frame_fields(run.sim, output_mesh(run.model), ["cauchy_stress", "von_mises"])
-    sigma = solid["cauchy_stress"].reshape(-1, 3, 3)
+    sigma = symmetric_tensors(solid["cauchy_stress"])
     deviator = sigma - np.trace(sigma, axis1=1, axis2=2)[:, None, None] * np.eye(3) / 3
     np.testing.assert_allclose(solid["von_mises"], np.sqrt(1.5 * (deviator ** 2).sum(axis=(1, 2))), rtol=1e-12)
     by_layer = solid["von_mises"].reshape(run.model.n_elements, nt, 9)
     np.testing.assert_array_equal(shell["von_mises"], by_layer.max(axis=1).ravel())
     weights = run.model.rule.wt / run.model.rule.wt.sum()
-    mean = np.einsum("k,ekqc->eqc", weights, solid["cauchy_stress"].reshape(run.model.n_elements, nt, 9, 9))
-    np.testing.assert_allclose(shell["cauchy_stress"], mean.reshape(-1, 9), rtol=1e-12, atol=1e-15)
+    mean = np.einsum("k,ekqc->eqc", weights, solid["cauchy_stress"].reshape(run.model.n_elements, nt, 9, 6))
+    np.testing.assert_allclose(shell["cauchy_stress"], mean.reshape(-1, 6), rtol=1e-12, atol=1e-15)
     assert (by_layer.max(axis=1) > 1.2 * by_layer.min(axis=1)).any()  # the faces differ: the choice matters
 
 
@@ -419,7 +544,8 @@ def mirrored_run(tmp_path_factory):
     text = text.replace('axes = { kind = "cylindrical", axis = [0.0, 0.0, 1.0] }',
                         'axes = { kind = "cylindrical", axis = [0.0, 0.0, 1.0], angle_deg = [-30.0, 30.0] }')
     assert "angle_deg" in text
-    text = text.replace("[output]\n", '[output]\nmirror = true\nformats = ["xdmf", "vtu"]\nsolid = true\n'
+    text = text.replace("[output]\n", '[output]\nmirror = ["sym_x", "sym_y", "z0"]\nformats = ["xdmf", "vtu"]\n'
+                        'solid = true\nprecision = "double"\n'
                         'fields = ["displacement", "cauchy_stress", "pressure_band", "fibres"]\n', 1)
     text += '\n[[output.render]]\nfield = "cauchy_stress"\nfibres = true\noutline = true\nsize = [640, 480]\n'
 
@@ -478,6 +604,28 @@ def test_mirror_needs_a_symmetry_plane_and_fibres_a_fibre_law():
         parse_deck(plate + "\n[output]\nmirror = true\n")
     with pytest.raises(DeckError, match="'fibres' draws a fibre-reinforced law's fibres"):
         parse_deck(plate + '\n[output]\nfields = ["displacement", "fibres"]\n')
+
+
+def test_mirror_names_its_planes_and_reflects_across_those_alone():
+    """A symmetry boundary may hold a vessel's cut end in its plane: ``mirror = true`` is
+    refused with the symmetry sets to choose from, a set that is no symmetry boundary's is
+    named, and the copies are made across the named planes only (two of Test 9's three:
+    four copies)."""
+    from shellsim.errors import DeckError
+    from shellsim.output.mirror import mirror_planes, mirrors
+
+    text = (ROOT / "decks" / "verification" / "test09_aorta_static.toml").read_text()
+    with pytest.raises(DeckError, match=r'mirror = true: name the symmetry boundaries .* as mirror = '
+                                        r'\["sym_x", "sym_y", "z0"\] or fewer'):
+        parse_deck(text.replace("[output]\n", "[output]\nmirror = true\n", 1))
+    with pytest.raises(DeckError, match="'ends' is not the set of a symmetry boundary; they are 'sym_x', 'sym_y', "
+                                        "'z0'"):
+        parse_deck(text.replace("[output]\n", '[output]\nmirror = ["sym_x", "ends"]\n', 1))
+    run = prepared(parse_deck(text.replace("[output]\n", '[output]\nmirror = ["sym_x", "z0"]\n', 1)))
+    planes = mirror_planes(run.deck, run.mesh)
+    normals = np.array([normal for normal, _ in planes])
+    np.testing.assert_allclose(np.abs(normals), [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    assert mirrors(planes).count == 4
 
 
 def test_a_static_vtu_series_has_its_times_and_renders_and_its_summary_is_strict_json(tmp_path):

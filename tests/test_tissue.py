@@ -41,8 +41,9 @@ def _has_fibres_and_a_picture(out) -> None:
     _, _, cell_data = reader.read_data(reader.num_steps - 1)
     fibres = [name for name in cell_data if name.startswith("fibre_")]
     assert fibres
-    for name in fibres:
-        np.testing.assert_allclose(np.linalg.norm(cell_data[name][0], axis=1), 1.0, rtol=1e-12)
+    for name in fibres:  # unit vectors, to the precision they are stored at
+        stored = cell_data[name][0]
+        np.testing.assert_allclose(np.linalg.norm(stored, axis=1), 1.0, rtol=4 * np.finfo(stored.dtype).eps)
     assert list((out / "renders").glob("pressure_band_iso_fibres_outline_*.png"))
 
 

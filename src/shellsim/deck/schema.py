@@ -7,6 +7,7 @@ deck (defaults filled) is what the program runs.
 
 from __future__ import annotations
 
+import json
 from typing import Annotated, ClassVar, Literal, Union
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
@@ -407,17 +408,21 @@ class Output(Section):
     which the time stepper lands on exactly) and at the end; the ``fields`` written in
     them (stresses and strains per integration-point sub-cell, with a smoothed nodal
     version); the ``formats`` (``xdmf``: results.xdmf + results.h5; ``vtu``: results.pvd +
-    frames/); ``solid`` writes the shell as a solid between its faces instead of its
-    mid-surface; ``mirror`` writes the model whole, reflected across the planes of its
-    ``symmetry`` boundaries (a quarter tube as eight copies with a z symmetry plane);
-    probes (history.csv), a valve's measures and renders."""
+    frames/), their numbers' ``precision`` (``single``: about 7 digits, half the size of
+    ``double``) and whether they are compressed (``compress``, lossless); ``solid`` writes
+    the shell as a solid between its faces instead of its mid-surface; ``mirror`` names the
+    ``symmetry`` boundaries (by their sets) that are planes of the model's symmetry, and
+    writes the model whole, reflected across them (a quarter tube as eight copies with a z
+    symmetry plane); probes (history.csv), a valve's measures and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
     fields: list[OutputField] = ["displacement", "director", "thickness", "cauchy_stress", "pressure_band"]
     formats: list[Literal["xdmf", "vtu"]] = ["xdmf"]
+    precision: Literal["single", "double"] = "single"
+    compress: bool = True
     solid: bool = False
-    mirror: bool = False
+    mirror: bool | list[str] = []
     probe: list[Probe] = []
     render: list[Render] = []
     valve: Valve | None = None
@@ -498,6 +503,23 @@ def _constitutive_path_problems(material, section: ShellSection) -> list[str]:
     return problems
 
 
+def _mirror_problems(mirror: bool | list[str], boundaries: list) -> list[str]:
+    """What is wrong with ``output.mirror``: it names symmetry boundaries' sets. ``true``
+    does not say which: a symmetry boundary may hold a vessel's cut end in its plane
+    rather than halve the model, and a copy reflected there is no part of the model."""
+    symmetric = [b.set for b in boundaries if b.type == "symmetry"]
+    if mirror is True:
+        if not symmetric:
+            return ["output.mirror: the deck has no symmetry boundary to mirror across"]
+        return [f"output.mirror = true: name the symmetry boundaries that are planes of the model's symmetry, "
+                f"as mirror = {json.dumps(symmetric)} or fewer (a "
+                "symmetry boundary may also hold a cut end in its plane, and a copy reflected there is no part "
+                "of the model)"]
+    known = f"they are {', '.join(repr(name) for name in symmetric)}" if symmetric else "the deck has none"
+    return [f"output.mirror: '{name}' is not the set of a symmetry boundary; {known}"
+            for name in mirror or [] if name not in symmetric]
+
+
 class Deck(Section):
     """A whole scene. Tables may come in any order; names are resolved after parsing."""
 
@@ -575,8 +597,7 @@ class Deck(Section):
                 f"got {self.mesh.divisions['width']}"
             )
         problems += _constitutive_path_problems(self.material, self.section)
-        if self.output.mirror and not any(b.type == "symmetry" for b in self.boundary):
-            problems.append("output.mirror: the deck has no symmetry boundary to mirror across")
+        problems += _mirror_problems(self.output.mirror, self.boundary)
         problems += [f"output.fields: '{name}' is the {what} of the [[contact]] tables, and the deck has none"
                      for name, what in (("contact_pressure", "pressure"), ("contact_gap", "gap"))
                      if name in self.output.fields and not self.contact]

@@ -28,6 +28,7 @@ from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
 from ..loads.cable import element_states
+from .encoding import symmetric_columns
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
@@ -229,8 +230,8 @@ def _columns(values: np.ndarray) -> np.ndarray:
 
 def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[dict, dict]:
     """(point_data, cell_data) of the current state for the requested ``fields``: arrays
-    of shape (P,) or (P, 3) on the points, (C,) or (C, 9) on the cells; tensors are written
-    row by row (xx, xy, xz, yx, ...), as ParaView reads a 9-component array."""
+    of shape (P,), (P, 3) or (P, 6) on the points, (C,), (C, 3) or (C, 6) on the cells;
+    the tensors, all symmetric, as their six components (:data:`SYMMETRIC_PAIRS`)."""
     model, state = sim.model, sim.state
     point_data: dict[str, np.ndarray] = {}
     if "displacement" in fields:
@@ -242,7 +243,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
         point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
     cell_data: dict[str, np.ndarray] = {}
     for name, values in _point_values(sim, fields).items():
-        flat = values.reshape(*values.shape[:3], -1)  # (ne, nq, nt, 1 or 9)
+        flat = symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
         if mesh.solid:
             cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
         else:

@@ -1,6 +1,6 @@
 """The whole model from the part a deck models: the viewing mesh and each frame's fields
-reflected across the deck's symmetry planes (``output.mirror``), so a quarter artery is
-written, and drawn, whole.
+reflected across the symmetry planes the deck names in ``output.mirror``, so a quarter
+artery is written, and drawn, whole.
 
 A plane is a ``symmetry`` boundary: its normal, through its set's nodes. k distinct planes
 give 2^k copies, each y -> R y + b with R a product of reflections I - 2 n n. Vectors
@@ -18,6 +18,7 @@ import numpy as np
 
 from ..deck import Deck
 from ..mesh import Mesh
+from .encoding import symmetric_columns, symmetric_tensors
 from .fields import OutputMesh
 
 #: Corner orders that reverse a quad's and a hexahedron's orientation.
@@ -37,13 +38,14 @@ class Mirrors:
         return len(self.turns)
 
 
-def symmetry_planes(deck: Deck, mesh: Mesh) -> list[tuple[np.ndarray, float]]:
-    """(unit normal n (3,), offset n . p) of each distinct symmetry plane of ``deck``, p
-    the first node of its set; planes equal within 1e-9 of the model's size count once."""
+def mirror_planes(deck: Deck, mesh: Mesh) -> list[tuple[np.ndarray, float]]:
+    """(unit normal n (3,), offset n . p) of each distinct symmetry plane named in
+    ``deck.output.mirror``, p the first node of its set; planes equal within 1e-9 of the
+    model's size count once."""
     size = float(np.ptp(mesh.x, axis=0).max()) or 1.0
     planes: list[tuple[np.ndarray, float]] = []
     for bc in deck.boundary:
-        if bc.type != "symmetry":
+        if bc.type != "symmetry" or bc.set not in (deck.output.mirror or []):
             continue
         normal = np.asarray(bc.normal, dtype=float)
         offset = float(normal @ mesh.x[mesh.sets[bc.set].nodes[0]])
@@ -77,11 +79,11 @@ def mirrored_mesh(mesh: OutputMesh, copies: Mirrors) -> OutputMesh:
 
 
 def mirrored_values(values: np.ndarray, copies: Mirrors) -> np.ndarray:
-    """A field's values (m,), (m, 3) or (m, 9) (a tensor row by row) for every copy, the
-    part's first: scalars repeated, vectors turned, tensors turned on both sides."""
+    """A field's values (m,), (m, 3) or (m, 6) (a symmetric tensor's components) for every
+    copy, the part's first: scalars repeated, vectors turned, tensors turned on both sides."""
     if values.ndim == 1:
         return np.tile(values, copies.count)
     if values.shape[1] == 3:
         return np.concatenate([values @ R.T for R in copies.turns])
-    tensors = values.reshape(-1, 3, 3)
-    return np.concatenate([(R @ tensors @ R.T).reshape(-1, 9) for R in copies.turns])
+    tensors = symmetric_tensors(values)
+    return np.concatenate([symmetric_columns(R @ tensors @ R.T) for R in copies.turns])

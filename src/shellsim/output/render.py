@@ -13,6 +13,7 @@ import numpy as np
 from ..deck.schema import TENSOR_COMPONENTS, VECTOR_COMPONENTS
 from ..element.shape import shape
 from ..errors import OutputError, ShellsimError
+from .encoding import SYMMETRIC_PAIRS
 from .folder import output_folder
 from ..mesh import Mesh
 
@@ -109,8 +110,8 @@ def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> 
 
 #: The outer ring of an element's 4 x 4 sub-cell corners (r fastest), closed.
 ELEMENT_RING = np.array([0, 1, 2, 3, 7, 11, 15, 14, 13, 12, 8, 4, 0])
-#: Columns of a row-by-row 3 x 3 tensor (a 3-vector's are the probes' own).
-TENSOR_COLUMNS = {name: 3 * row + column for name, (row, column) in TENSOR_COMPONENTS.items()}
+#: Columns of a written symmetric tensor (a 3-vector's are the probes' own).
+TENSOR_COLUMNS = {name: SYMMETRIC_PAIRS.index(tuple(sorted(pair))) for name, pair in TENSOR_COMPONENTS.items()}
 RENDERS_DIR = "renders"
 
 
@@ -123,12 +124,12 @@ def field_values(point_data: dict, cell_data: dict, field: str, component: str |
         raise OutputError(f"field '{field}' is not in the results; written fields: {', '.join(known)}")
     values = np.asarray((cell_data if on_cells else point_data)[field], dtype=float)
     columns = values.shape[1] if values.ndim == 2 else 1
-    named = {1: {}, 3: VECTOR_COMPONENTS | {"magnitude": None}, 9: TENSOR_COLUMNS}[columns]
+    named = {1: {}, 3: VECTOR_COMPONENTS | {"magnitude": None}, 6: TENSOR_COLUMNS}[columns]
     if columns == 1:
         if component is not None:
             raise OutputError(f"field '{field}' is a scalar; leave out the component")
         return values.reshape(-1), on_cells, ""
-    component = component or ("xx" if columns == 9 else "magnitude")
+    component = component or ("xx" if columns == 6 else "magnitude")
     if component not in named:
         raise OutputError(f"component '{component}' does not fit field '{field}'; expected one of {', '.join(named)}")
     column = named[component]

@@ -1,12 +1,7 @@
-"""Time series of output frames: ``results.xdmf`` + ``results.h5``, and ``results.pvd`` +
-``frames/*.vtu``, each left readable after every frame, so a run that stops (Ctrl-C, a
-numerical failure, a killed process) keeps every frame written so far.
-
-The XDMF series is meshio's own ``TimeSeriesWriter`` layout (``meshio.xdmf.TimeSeriesReader``
-and ParaView read it) with two changes: the ``.h5`` is created beside the ``.xdmf``, not in
-the working directory, and the XML is rewritten atomically after every frame instead of
-only on close.
-"""
+"""Time series of output frames: ``results.xdmf`` + ``results.h5`` (:mod:`.xdmf`), and
+``results.pvd`` + ``frames/*.vtu`` (:mod:`.vtu`), each left readable after every frame, so a
+run that stops (Ctrl-C, a numerical failure, a killed process) keeps every frame written so
+far; and a written series read back."""
 
 from __future__ import annotations
 
@@ -19,68 +14,15 @@ import numpy as np
 from ..deck.schema import Output
 from ..errors import OutputError
 from ..solver.run import Listener, Run
-from .fields import OutputMesh, cable_fields, cable_mesh, frame_fields, output_mesh
-from .folder import write_atomically
-from .mirror import mirrored_mesh, mirrored_values, mirrors, symmetry_planes
+from .encoding import Encoding
+from .fields import cable_fields, cable_mesh, frame_fields, output_mesh
+from .mirror import mirror_planes, mirrored_mesh, mirrored_values, mirrors
+from .vtu import VtuSeries
+from .xdmf import XdmfSeries
 
-XDMF_NAME, PVD_NAME, FRAMES_DIR = "results.xdmf", "results.pvd", "frames"
+XDMF_NAME, PVD_NAME = "results.xdmf", "results.pvd"
 #: The cables' own series (line cells), beside the shells' (:func:`shellsim.output.fields.cable_mesh`).
 CABLES = "cables"
-
-
-class XdmfSeries:
-    """``<name>.xdmf`` + ``<name>.h5`` in ``folder``, on ``mesh`` (its points, cells and
-    cell type)."""
-
-    def __init__(self, folder: Path, mesh: OutputMesh, name: str = "results"):
-        import h5py
-        from meshio.xdmf import TimeSeriesWriter
-
-        self.path = folder / f"{name}.xdmf"
-        self._writer = TimeSeriesWriter(self.path)
-        self._writer.h5_filename = str(self.path.with_suffix(".h5"))  # referenced by its base name
-        self._writer.h5_file = h5py.File(self._writer.h5_filename, "w")
-        self._writer.write_points_cells(mesh.points, {mesh.cell_type: mesh.cells})
-
-    def write(self, t: float, point_data: dict, cell_data: dict) -> None:
-        self._writer.write_data(t, point_data, {name: [values] for name, values in cell_data.items()})
-        self._writer.h5_file.flush()
-        write_atomically(self.path, ET.tostring(self._writer.xdmf_file))
-
-    def close(self) -> None:
-        self._writer.h5_file.close()
-
-
-class VtuSeries:
-    """``<name>.pvd`` indexing one ``<frames>/<name>_NNNN.vtu`` per frame, in ``folder``
-    (frames: ``frames`` for the results, ``<name>_frames`` for another series)."""
-
-    def __init__(self, folder: Path, mesh: OutputMesh, name: str = "results"):
-        self.name = name
-        self.path = folder / f"{name}.pvd"
-        self.frames = folder / (FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}")
-        if self.frames.exists():  # frames of an earlier run would be listed by nobody
-            shutil.rmtree(self.frames)
-        self.frames.mkdir()
-        self.mesh = mesh
-        self.entries: list[tuple[float, str]] = []
-
-    def write(self, t: float, point_data: dict, cell_data: dict) -> None:
-        import meshio
-
-        name = f"{self.frames.name}/{self.name}_{len(self.entries):04d}.vtu"
-        meshio.write(self.path.parent / name, meshio.Mesh(
-            self.mesh.points, [(self.mesh.cell_type, self.mesh.cells)], point_data=point_data,
-            cell_data={key: [values] for key, values in cell_data.items()}), file_format="vtu")
-        self.entries.append((t, name))
-        root = ET.Element("VTKFile", type="Collection", version="0.1")
-        collection = ET.SubElement(root, "Collection")
-        for time, file in self.entries:
-            ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
-        write_atomically(self.path, ET.tostring(root, xml_declaration=True))
-
-    def close(self) -> None:
-        pass
 
 
 SERIES = {"xdmf": XdmfSeries, "vtu": VtuSeries}
@@ -92,16 +34,17 @@ class FrameWriter(Listener):
     def __init__(self, folder: Path, run: Run, output: Output):
         self.fields = list(output.fields)
         self.part = output_mesh(run.model, output.solid)
-        self.copies = mirrors(symmetry_planes(run.deck, run.mesh) if output.mirror else [])
+        self.copies = mirrors(mirror_planes(run.deck, run.mesh))
         self.mesh = mirrored_mesh(self.part, self.copies)
         self.run = run
         self.cables = cable_mesh(run.model)
+        self.encoding = Encoding.of(output)
         self.series, self.cable_series = [], []
         try:
             for kind in dict.fromkeys(output.formats):
-                self.series.append(SERIES[kind](folder, self.mesh))
+                self.series.append(SERIES[kind](folder, self.mesh, self.encoding))
                 if self.cables is not None:
-                    self.cable_series.append(SERIES[kind](folder, self.cables, CABLES))
+                    self.cable_series.append(SERIES[kind](folder, self.cables, self.encoding, CABLES))
         except OSError as error:
             self.close()
             raise OutputError(f"cannot write the {kind} series in '{folder}': {error.strerror or error}") from None
@@ -115,9 +58,11 @@ class FrameWriter(Listener):
                 {name: mirrored_values(v, self.copies) for name, v in cell_data.items()})
 
     def frame_bytes(self) -> int:
-        """Bytes one frame of the current state takes in every format (data only)."""
+        """Bytes one frame of the current state takes in every format, uncompressed (data
+        only)."""
         point_data, cell_data = self._fields(self.run)
-        return len(self.series) * sum(a.nbytes for a in (*point_data.values(), *cell_data.values()))
+        values = sum(a.size for a in (*point_data.values(), *cell_data.values()))
+        return len(self.series) * values * np.dtype(self.encoding.float_type).itemsize
 
     def on_frame(self, run: Run) -> None:
         point_data, cell_data = self._fields(run)

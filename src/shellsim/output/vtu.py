@@ -1,0 +1,52 @@
+"""``<name>.pvd`` indexing one ``<frames>/<name>_NNNN.vtu`` per frame; the index is
+rewritten atomically after every frame, and lists a frame only once it is whole."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from .encoding import Encoding
+from .folder import write_atomically
+
+FRAMES_DIR = "frames"
+
+
+class VtuSeries:
+    """``<name>.pvd`` + one VTU per frame in ``folder`` (frames in ``frames`` for the
+    results, ``<name>_frames`` for another series), on ``mesh`` (its points (P, 3), cells
+    (C, k) and cell type), numbers stored as ``encoding`` says."""
+
+    def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results"):
+        self.name = name
+        self.path = folder / f"{name}.pvd"
+        self.frames = folder / (FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}")
+        if self.frames.exists():  # frames of an earlier run would be listed by nobody
+            shutil.rmtree(self.frames)
+        self.frames.mkdir()
+        self.mesh = mesh
+        self.encoding = encoding
+        self.entries: list[tuple[float, str]] = []
+
+    def write(self, t: float, point_data: dict, cell_data: dict) -> None:
+        """Add the frame at time ``t``: fields (P,) or (P, k) on the points, (C,) or (C, k)
+        on the cells."""
+        import meshio
+
+        floats = self.encoding.floats
+        name = f"{self.frames.name}/{self.name}_{len(self.entries):04d}.vtu"
+        meshio.write(self.path.parent / name, meshio.Mesh(
+            floats(self.mesh.points), [(self.mesh.cell_type, self.mesh.cells)],
+            point_data={key: floats(values) for key, values in point_data.items()},
+            cell_data={key: [floats(values)] for key, values in cell_data.items()}),
+            file_format="vtu", compression="zlib" if self.encoding.compress else None)
+        self.entries.append((float(t), name))
+        root = ET.Element("VTKFile", type="Collection", version="0.1")
+        collection = ET.SubElement(root, "Collection")
+        for time, file in self.entries:
+            ET.SubElement(collection, "DataSet", timestep=repr(time), part="0", file=file)
+        write_atomically(self.path, ET.tostring(root, xml_declaration=True))
+
+    def close(self) -> None:
+        pass

@@ -602,7 +602,7 @@ def test_mirror_needs_a_symmetry_plane_and_fibres_a_fibre_law():
     plate = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0')
     with pytest.raises(DeckError, match="no symmetry boundary to mirror across"):
         parse_deck(plate + "\n[output]\nmirror = true\n")
-    with pytest.raises(DeckError, match="'fibres' draws a fibre-reinforced law's fibres"):
+    with pytest.raises(DeckError, match="'fibres' is of a fibre-reinforced law's fibres"):
         parse_deck(plate + '\n[output]\nfields = ["displacement", "fibres"]\n')
 
 

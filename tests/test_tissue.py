@@ -8,6 +8,7 @@ from __future__ import annotations
 import meshio
 import numpy as np
 import pytest
+from shellsim.output.fields import is_fibre_direction
 from shellsim.study.jobs import variant_deck
 
 from .conftest import ROOT
@@ -39,7 +40,7 @@ def _has_fibres_and_a_picture(out) -> None:
     reader = meshio.xdmf.TimeSeriesReader(out / "results.xdmf")
     reader.read_points_cells()
     _, _, cell_data = reader.read_data(reader.num_steps - 1)
-    fibres = [name for name in cell_data if name.startswith("fibre_")]
+    fibres = [name for name in cell_data if is_fibre_direction(name)]
     assert fibres
     for name in fibres:  # unit vectors, to the precision they are stored at
         stored = cell_data[name][0]

@@ -130,26 +130,32 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
-    a3 the lamina normal g_r x g_s / |.|, a1 the axes' preferred direction projected on
-    the lamina (:class:`shellsim.materials.axes.TurnedAxes`; g_r for an isotropic law or where
-    the preferred direction is normal to the lamina, e.g. on a tube's axis), then turned
-    about a3 by the layer's ``axes.angle_deg``; a2 = a3 x a1."""
+    :func:`lamina_axes` of the axes' preferred direction (:class:`shellsim.materials.axes.TurnedAxes`;
+    g_r for an isotropic law), a1 then turned about a3 by the layer's ``axes.angle_deg``."""
     out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
     turns = np.zeros(len(tz)) if axes is None else axes.angles(tz)
     for k, t in enumerate(tz):
         position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)
-        g_r, g_s = jac[..., 0], jac[..., 1]
-        normal = np.cross(g_r, g_s)
-        normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-        preferred = g_r if axes is None else axes.preferred(position, mesh.cell_vectors)
-        a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
-        size = np.linalg.norm(a1, axis=-1, keepdims=True)
-        fallback = g_r - np.sum(g_r * normal, axis=-1, keepdims=True) * normal
-        a1 = np.where(size > 1e-9 * np.linalg.norm(preferred, axis=-1, keepdims=True) + 1e-300, a1, fallback)
-        a1 /= np.linalg.norm(a1, axis=-1, keepdims=True)
-        a1 = np.cos(turns[k]) * a1 + np.sin(turns[k]) * np.cross(normal, a1)
-        out[:, :, k] = np.stack([a1, np.cross(normal, a1), normal], axis=-2)
+        frames = lamina_axes(jac, jac[..., 0] if axes is None else axes.preferred(position, mesh.cell_vectors))
+        a1 = np.cos(turns[k]) * frames[..., 0, :] + np.sin(turns[k]) * frames[..., 1, :]
+        out[:, :, k] = np.stack([a1, np.cross(frames[..., 2, :], a1), frames[..., 2, :]], axis=-2)
     return out
+
+
+def lamina_axes(jac: np.ndarray, preferred: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) orthonormal frames, rows (a1, a2, a3), at points with Jacobians ``jac``
+    (..., 3, 3; columns g_r, g_s, g_t): a3 the lamina normal g_r x g_s / |.|, a1
+    ``preferred`` (..., 3) projected on the lamina (g_r where it is normal to the lamina,
+    e.g. on a tube's axis), a2 = a3 x a1."""
+    g_r, g_s = jac[..., 0], jac[..., 1]
+    normal = np.cross(g_r, g_s)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    a1 = preferred - np.sum(preferred * normal, axis=-1, keepdims=True) * normal
+    size = np.linalg.norm(a1, axis=-1, keepdims=True)
+    fallback = g_r - np.sum(g_r * normal, axis=-1, keepdims=True) * normal
+    a1 = np.where(size > 1e-9 * np.linalg.norm(preferred, axis=-1, keepdims=True) + 1e-300, a1, fallback)
+    a1 /= np.linalg.norm(a1, axis=-1, keepdims=True)
+    return np.stack([a1, np.cross(normal, a1), normal], axis=-2)
 
 
 def volumetric_basis(plane_strain: bool, N_gauss: np.ndarray) -> np.ndarray:

@@ -8,13 +8,14 @@ deck (defaults filled) is what the program runs.
 from __future__ import annotations
 
 import json
-from typing import Annotated, ClassVar, Literal, Union
+from typing import Annotated, ClassVar, Literal, Union, get_args
 
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from .curves import Curve
 from .geometry import BUILDERS, Geometry, proportion_problems
 from .material import MATERIALS, Material
+from ..materials.axes import CentrelineAxes, CylindricalAxes
 from ..loads import CABLE_TABLES, CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
 from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, need_directions, repeated
@@ -279,8 +280,19 @@ class Solver(Section):
 
 OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
-    "pressure_band", "green_lagrange_strain", "von_mises", "fibres", "contact_pressure", "contact_gap",
+    "pressure_band", "green_lagrange_strain", "von_mises", "principal_stress", "vessel_stress", "fibres",
+    "fibre_stretch", "contact_pressure", "contact_gap",
 ]
+#: The axes a vessel's stresses are read in: a tube's or a curved vessel's.
+VesselAxes = Annotated[Union[CylindricalAxes, CentrelineAxes], Field(discriminator="kind")]
+#: Fields a fibre-reinforced law alone has.
+FIBRE_FIELDS = ("fibres", "fibre_stretch")
+#: The scalar arrays a field writes under other names, by the field (a render draws them).
+WRITTEN_AS = {"principal_stress": tuple(f"principal_stress_{k}" for k in (1, 2, 3)),
+              "vessel_stress": ("hoop_stress", "axial_stress", "radial_stress"),
+              "fibre_stretch": ("fibre_stretch_1", "fibre_stretch_2")}
+#: What a render may colour: a field, or an array one writes.
+Drawn = Literal[(*get_args(OutputField), *(name for names in WRITTEN_AS.values() for name in names))]
 #: The probes' vocabulary (one place: the schema, the probes and the renders read it).
 #: Quantities by kind; those read at the integration point nearest to a probe's set.
 VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
@@ -347,12 +359,13 @@ class Probe(Section):
 
 class Render(Section):
     """PNGs written at the end of a completed run (as ``shellsim render``): ``field``
-    (one of the written ``output.fields``) on the deformed shape, for the ``last`` frame,
+    (one of the written ``output.fields``, or an array one of them writes, e.g.
+    ``hoop_stress`` of ``vessel_stress``) on the deformed shape, for the ``last`` frame,
     a frame number, or ``all`` (also an animated GIF), seen from ``view``, ``size`` pixels;
     ``fibres`` draws the fibre directions over it (with ``fibres`` among the fields),
     ``outline`` the initial shape's element outlines."""
 
-    field: OutputField = "pressure_band"
+    field: Drawn = "pressure_band"
     frame: Literal["last", "all"] | Count = "last"
     view: Literal["iso", "top", "front", "side"] = "iso"
     size: tuple[Count, Count] = (1200, 900)
@@ -364,6 +377,8 @@ class Render(Section):
     def _coloured(cls, field: str) -> str:
         if field == "fibres":
             raise ValueError("fibres are drawn over a coloured field: give another field and fibres = true")
+        if field in WRITTEN_AS:
+            raise ValueError(f"'{field}' writes {', '.join(WRITTEN_AS[field])}: colour one of them")
         return field
 
 
@@ -413,7 +428,9 @@ class Output(Section):
     the shell as a solid between its faces instead of its mid-surface; ``mirror`` names the
     ``symmetry`` boundaries (by their sets) that are planes of the model's symmetry, and
     writes the model whole, reflected across them (a quarter tube as eight copies with a z
-    symmetry plane); probes (history.csv), a valve's measures and renders."""
+    symmetry plane); ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop
+    and axial stresses in (by default the material's, when they are a tube's or a
+    centreline's); probes (history.csv), a valve's measures and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
@@ -423,6 +440,7 @@ class Output(Section):
     compress: bool = True
     solid: bool = False
     mirror: bool | list[str] = []
+    vessel_axes: VesselAxes | None = None
     probe: list[Probe] = []
     render: list[Render] = []
     valve: Valve | None = None
@@ -433,7 +451,8 @@ class Output(Section):
             raise ValueError("give either 'interval' or 'times', not both")
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
             raise ValueError(f"'times' must be strictly increasing, got {self.times}")
-        drawn = {r.field for r in self.render} | {"fibres" for r in self.render if r.fibres}
+        written_by = {name: field for field, names in WRITTEN_AS.items() for name in names}
+        drawn = {written_by.get(r.field, r.field) for r in self.render} | {"fibres" for r in self.render if r.fibres}
         unwritten = sorted(drawn - set(self.fields))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
@@ -520,6 +539,18 @@ def _mirror_problems(mirror: bool | list[str], boundaries: list) -> list[str]:
             for name in mirror or [] if name not in symmetric]
 
 
+def _vessel_axes_problems(output: Output) -> list[str]:
+    """``vessel_stress`` needs vessel axes, which are not turned."""
+    if "vessel_stress" in output.fields and output.vessel_axes is None:
+        return ["output.fields: 'vessel_stress' reads the stress in a vessel's axes: give output.vessel_axes = "
+                "{ kind = 'cylindrical', axis = [...], origin = [...] } or { kind = 'centreline', points = [...] } "
+                "(a fibre-reinforced material's own tube or centreline axes serve when it has them)"]
+    if output.vessel_axes is not None and output.vessel_axes.angle_deg != 0.0:
+        return [f"output.vessel_axes.angle_deg = {output.vessel_axes.angle_deg}: a vessel's axes are not turned; "
+                "leave it out"]
+    return []
+
+
 class Deck(Section):
     """A whole scene. Tables may come in any order; names are resolved after parsing."""
 
@@ -560,6 +591,13 @@ class Deck(Section):
         section = data.get("section")
         if model is not None and model.HYPERELASTIC and isinstance(section, dict):
             data["section"] = {"technique": 1} | section
+        output, material = data.get("output"), data.get("material")
+        if (isinstance(output, dict) and "vessel_stress" in output.get("fields", []) and "vessel_axes" not in output
+                and model is not None and model.ANISOTROPIC and isinstance(material, dict)):
+            axes = material.get("axes", {"kind": "cylindrical"})  # the law's own default
+            if isinstance(axes, dict) and axes.get("kind") in ("cylindrical", "centreline"):
+                data["output"] = output | {"vessel_axes": {key: value for key, value in axes.items()
+                                                           if key != "angle_deg"}}
         return data
 
     @model_validator(mode="after")
@@ -601,9 +639,10 @@ class Deck(Section):
         problems += [f"output.fields: '{name}' is the {what} of the [[contact]] tables, and the deck has none"
                      for name, what in (("contact_pressure", "pressure"), ("contact_gap", "gap"))
                      if name in self.output.fields and not self.contact]
-        if "fibres" in self.output.fields and not self.material.ANISOTROPIC:
-            problems.append(f"output.fields: 'fibres' draws a fibre-reinforced law's fibres, and material.model = "
-                            f"'{self.material.model}' has none")
+        if not self.material.ANISOTROPIC:
+            problems += [f"output.fields: '{name}' is of a fibre-reinforced law's fibres, and material.model = "
+                         f"'{self.material.model}' has none" for name in FIBRE_FIELDS if name in self.output.fields]
+        problems += _vessel_axes_problems(self.output)
         problems += proportion_problems(self.geometry, self.section.thickness)
         if self.solver.method == "static":
             problems += [f"contact[{i}].friction = {c.friction:g}: friction opposes sliding velocities, and a static "

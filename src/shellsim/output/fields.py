@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..deck.schema import WRITTEN_AS
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import NODE_RS, gauss_rule, shape
 from ..materials.laws import LAWS
@@ -28,13 +29,17 @@ from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
 from ..loads.cable import element_states
+from .derived import VESSEL_STRESSES, normal_components, principal_stresses, vessel_frames
 from .encoding import symmetric_columns
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
+#: Fields derived from the Cauchy stress, cells only: principal_stress_k and
+#: principal_direction_k (k = 1, 2, 3, largest first); hoop_, axial_ and radial_stress.
+PRINCIPAL, VESSEL = "principal_stress", "vessel_stress"
 #: The output field of fibre directions, written as one cell vector per family:
-#: fibre_1, fibre_2, ...
-FIBRES, FIBRE_PREFIX = "fibres", "fibre_"
+#: fibre_1, fibre_2, ...; and of their stretches, fibre_stretch_1, ...
+FIBRES, FIBRE_PREFIX, FIBRE_STRETCH = "fibres", "fibre_", "fibre_stretch"
 NODAL_SUFFIX = "_nodal"
 CONTACT_PRESSURE, CONTACT_GAP = "contact_pressure", "contact_gap"
 #: Fields the shell view shows as their largest value through the thickness (a bent
@@ -44,7 +49,8 @@ LARGEST_THROUGH_THICKNESS = ("von_mises",)
 #: What each field or probe quantity measures, for units in titles and axis labels.
 FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
-              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time"}
+              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time",
+              **dict.fromkeys((*WRITTEN_AS[PRINCIPAL], *WRITTEN_AS[VESSEL]), "stress")}
 #: Units of each kind per deck unit system (meta.units); nothing is converted.
 UNITS = {"SI": {"length": "m", "area": "m^2", "stress": "Pa", "time": "s"},
          "mm-t-s": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
@@ -65,6 +71,11 @@ CORNER_N = shape(CORNER_RS)
 CORNER_HATS = np.prod(np.clip(1.0 - np.abs(CORNER_RS[:, None, :] - NODE_RS[None]), 0.0, None), axis=2)
 #: Corners of the sub-cell of in-plane point q = i_r + 3 i_s (counter-clockwise). Shape (9, 4).
 SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in range(3) for i in range(3))])
+
+
+def is_fibre_direction(name: str) -> bool:
+    """Whether a written array ``name`` is a fibre family's direction (fibre_1, not fibre_stretch_1)."""
+    return name.startswith(FIBRE_PREFIX) and name[len(FIBRE_PREFIX):].isdigit()
 
 
 def labelled(text: str, field: str, system: str) -> str:
@@ -173,11 +184,10 @@ def von_mises(sigma: np.ndarray) -> np.ndarray:
     return np.sqrt(1.5 * np.einsum("...ij,...ij->...", deviator, deviator))
 
 
-def _point_values(sim: Simulation, fields: list[str]) -> dict[str, np.ndarray]:
-    """Each requested cell field at every integration point, (ne, nq, nt, ...)."""
-    if not set(fields) & set(CELL_FIELDS):
-        return {}  # no stress or strain asked for: nothing to sample
-    lamina, cauchy, green = sim.point_tensors()
+def _point_values(tensors: tuple[np.ndarray, ...], fields: list[str]) -> dict[str, np.ndarray]:
+    """Each requested cell field at every integration point, (ne, nq, nt, ...), from the
+    (lamina, Cauchy, Green-Lagrange) tensors there."""
+    lamina, cauchy, green = tensors
     values = {"cauchy_stress": cauchy, "lamina_stress": lamina, "green_lagrange_strain": green,
               "pressure_band": pressure_band(cauchy)}
     if "von_mises" in fields:
@@ -192,11 +202,12 @@ def contact_pressure(sim: Simulation, mesh: OutputMesh) -> np.ndarray:
     return np.linalg.norm(forces, axis=1) / mesh.node_areas
 
 
-def fibre_directions(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
-    """Each fibre family's current unit direction at every in-plane integration point of
-    the ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family:
-    its initial direction (the law's ``fibres`` in the initial material frame) carried by
-    the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1."""
+def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
+    """Each fibre family's current vector F a0 at every in-plane integration point of the
+    ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family: its
+    initial unit direction a0 (the law's ``fibres`` in the initial material frame) carried
+    by the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1; its length is the
+    fibre's stretch, sqrt(I4)."""
     model, state, rule = sim.model, sim.state, sim.model.rule
     nq = len(rule.wq)
     F = np.empty((model.n_elements, nq, len(layers), 3, 3))
@@ -205,11 +216,8 @@ def fibre_directions(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
                              rule.tz[k])[1]
         F[:, :, column] = jac @ model.body.jac0_inv[:, :nq, k]
     frames = model.material.axes0[:, :, layers]  # rows: material axes 1, 2, 3
-    directions = []
-    for c, s in LAWS[model.material.law].fibres(model.material.params):
-        current = np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
-        directions.append(current / np.linalg.norm(current, axis=-1, keepdims=True))
-    return directions
+    return [np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
+            for c, s in LAWS[model.material.law].fibres(model.material.params)]
 
 
 def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.ndarray:
@@ -228,10 +236,17 @@ def _columns(values: np.ndarray) -> np.ndarray:
     return values[:, 0] if values.shape[1] == 1 else values
 
 
-def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[dict, dict]:
+def _on_cells(values: np.ndarray, mesh: OutputMesh) -> np.ndarray:
+    """Values (ne, nq, L, ...) at the integration points of the view's L layers as cell
+    values (C, ...): the solid view's cells run over elements, layers, points."""
+    return np.swapaxes(values, 1, 2).reshape(len(mesh.cells), *values.shape[3:])
+
+
+def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_axes=None) -> tuple[dict, dict]:
     """(point_data, cell_data) of the current state for the requested ``fields``: arrays
     of shape (P,), (P, 3) or (P, 6) on the points, (C,), (C, 3) or (C, 6) on the cells;
-    the tensors, all symmetric, as their six components (:data:`SYMMETRIC_PAIRS`)."""
+    the tensors, all symmetric, as their six components (:data:`SYMMETRIC_PAIRS`);
+    ``vessel_axes`` (a tube's or centreline's axes) for ``vessel_stress``."""
     model, state = sim.model, sim.state
     point_data: dict[str, np.ndarray] = {}
     if "displacement" in fields:
@@ -242,7 +257,8 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
     if "thickness" in fields:
         point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
     cell_data: dict[str, np.ndarray] = {}
-    for name, values in _point_values(sim, fields).items():
+    tensors = sim.point_tensors() if set(fields) & {*CELL_FIELDS, PRINCIPAL, VESSEL} else None
+    for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items():
         flat = symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
         if mesh.solid:
             cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
@@ -256,9 +272,23 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str]) -> tuple[
     if CONTACT_GAP in fields:
         gaps = ToolForces(sim.model, []).gaps(sim.state.t, sim.state.fields.shape)
         point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers), CORNER_HATS)
-    if FIBRES in fields:  # every layer's in the solid view, the middle layer's in the shell view
+    if {PRINCIPAL, VESSEL} & set(fields):  # of each layer's stress in the solid view, of the mean in the shell view
+        cauchy = tensors[1] if mesh.solid else thickness_mean(tensors[1], model.rule.wt, axis=2)[:, :, None]
+        if PRINCIPAL in fields:
+            values, directions = principal_stresses(cauchy)
+            for k, name in enumerate(WRITTEN_AS[PRINCIPAL]):
+                cell_data[name] = _on_cells(values[..., k], mesh)
+                cell_data[f"principal_direction_{k + 1}"] = _on_cells(directions[..., k, :], mesh)
+        if VESSEL in fields:
+            frames = vessel_frames(sim, vessel_axes, model.rule.tz if mesh.solid else np.zeros(1))
+            for name, values in zip(VESSEL_STRESSES, np.moveaxis(normal_components(cauchy, frames), -1, 0)):
+                cell_data[name] = _on_cells(values, mesh)
+    if {FIBRES, FIBRE_STRETCH} & set(fields):  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
-        for family, directions in enumerate(fibre_directions(sim, list(range(nt)) if mesh.solid else [nt // 2]),
-                                            start=1):
-            cell_data[f"{FIBRE_PREFIX}{family}"] = directions.transpose(0, 2, 1, 3).reshape(-1, 3)
+        for family, vectors in enumerate(fibre_vectors(sim, list(range(nt)) if mesh.solid else [nt // 2]), start=1):
+            stretch = np.linalg.norm(vectors, axis=-1)
+            if FIBRES in fields:
+                cell_data[f"{FIBRE_PREFIX}{family}"] = _on_cells(vectors / stretch[..., None], mesh)
+            if FIBRE_STRETCH in fields:
+                cell_data[f"{FIBRE_STRETCH}_{family}"] = _on_cells(stretch, mesh)
     return point_data, cell_data

@@ -189,7 +189,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
     to ``out_dir`` (default ``folder/renders``), with the ``overlays``. ``on_frame(done,
     total)`` hears of each picture written. Returns the files written."""
-    from .fields import FIBRE_PREFIX, NODAL_SUFFIX, labelled
+    from .fields import NODAL_SUFFIX, is_fibre_direction, labelled
     from .series import CABLES, StoredSeries
 
     series = StoredSeries(folder)
@@ -211,14 +211,14 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     out_dir = output_folder(out_dir or folder / RENDERS_DIR)
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []
-    if overlays.fibres and not any(name.startswith(FIBRE_PREFIX) for name in frames[0][1]):
+    if overlays.fibres and not any(map(is_fibre_direction, frames[0][1])):
         raise OutputError(f"the series in '{folder}' holds no fibre directions; write them with "
                           "output.fields = [..., 'fibres'] (a fibre-reinforced material)")
     stem += "".join(f"_{name}" for name, shown in overlays._asdict().items() if shown)
     for index, (point_data, cell_data), (values, on_cells, _) in zip(indices, frames, picked):
         path = out_dir / f"{stem}_{index:04d}.png"
         deformed = series.points + np.asarray(point_data.get("displacement", 0.0))
-        fibres = tuple(v for name, v in sorted(cell_data.items()) if overlays.fibres and name.startswith(FIBRE_PREFIX))
+        fibres = tuple(v for name, v in sorted(cell_data.items()) if overlays.fibres and is_fibre_direction(name))
         chords = None
         if cables is not None:  # written with the shells' frames, frame for frame
             chords = (cables.points + np.asarray(cables.frame(index)[0]["displacement"]), cables.cells)

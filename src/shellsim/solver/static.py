@@ -26,6 +26,8 @@ from .sparse_lu import SymmetricPatternLU
 CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
 #: Modified Newton forms a new tangent when an iteration leaves more than this share of the residual.
 SLOW = 0.5
+#: Halvings a correction from a fresh tangent may take while it makes the residual larger.
+LINE_SEARCH_HALVINGS = 4
 
 
 @dataclass
@@ -127,15 +129,17 @@ class NewtonSolver:
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale")
-            if self.tangent is None or settings.newton == "full" or norm > SLOW * previous:
+            fresh = self.tangent is None or settings.newton == "full" or norm > SLOW * previous
+            if fresh:
                 if before is not None and norm > previous:  # an old tangent led away: undo its correction
                     (before_state, pending, residual, norm) = before
                     before_state.restore(self.run.sim)
                     eq.evaluate(t)
                 self.tangent, before = self.linearised(), None
                 tangents += 1
-            else:
-                before = (Converged(self.run.sim), pending, residual, norm)
+            start = Converged(self.run.sim)
+            if not fresh:
+                before = (start, pending, residual, norm)
             previous = norm
             tangent, lu, _ = self.tangent
             rhs = residual - tangent[:, n_free:] @ pending if np.any(pending) else residual
@@ -143,9 +147,25 @@ class NewtonSolver:
             if first_energy is None:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
             eq.move(np.concatenate([correction, pending]))
-            pending = np.zeros_like(known)
             eq.evaluate(t)
+            if fresh and not np.any(pending):
+                self._line_search(t, start, correction, norm)
+            pending = np.zeros_like(known)
         raise AssertionError("unreachable")
+
+    def _line_search(self, t: float, start: Converged, correction: np.ndarray, norm: float) -> None:
+        """After a fresh tangent's ``correction`` from ``start`` (residual ``norm``) made the
+        residual larger, take half of it, a quarter, ... while that is so: where contact
+        comes on or off, or a fibre family is recruited, the tangent at the start does not
+        hold across the step, and the whole correction can overshoot to a state where every
+        next one does too."""
+        for _ in range(LINE_SEARCH_HALVINGS):
+            if np.linalg.norm(self.eq.residual()[:self.n_free]) <= norm:
+                return
+            correction = 0.5 * correction
+            start.restore(self.run.sim)
+            self.eq.move(np.concatenate([correction, np.zeros(self.eq.unknowns.n_known)]))
+            self.eq.evaluate(t)
 
     def held_apart(self, t: float) -> None:
         """Raises NotConverged when the equilibrium just found at load time t has contact

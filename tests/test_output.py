@@ -628,6 +628,48 @@ def test_mirror_names_its_planes_and_reflects_across_those_alone():
     assert mirrors(planes).count == 4
 
 
+def test_display_units_convert_what_renders_and_plots_show():
+    """Lengths, stresses, pressures, areas and times in the units asked, from any unit
+    system; a pressure follows the stresses' unit unless given its own; a field's nodal
+    version is shown as the field."""
+    from shellsim.output.units import DisplayUnits
+
+    units = DisplayUnits("SI", {"length": "mm", "stress": "kPa", "pressure": "mmHg"})
+    assert units.scale("displacement") == 1e3 and units.label("r", "position") == "r (mm)"
+    assert units.scale("hoop_stress") == 1e-3 and units.label("s", "cauchy_stress_nodal") == "s (kPa)"
+    assert units.scale("pressure") == pytest.approx(1.0 / 133.322387415, rel=1e-15)
+    assert units.scale("area") == pytest.approx(1e6, rel=1e-15) and units.label("A", "area") == "A (mm^2)"
+    assert units.scale("time") == 1.0 and units.label("t", "time") == "t (s)"
+    assert DisplayUnits("mm-kg-ms", {"stress": "kPa", "time": "s"}).scale("pressure") == pytest.approx(1e6)
+    assert DisplayUnits("mm-kg-ms", {"time": "s"}).scale("time") == pytest.approx(1e-3)
+    assert DisplayUnits().label("t", "time") == "t" and DisplayUnits().scale("stress") == 1.0
+    plate = PLATE.replace('precision = "double"', 'display_units = { stress = "bar" }')
+    with pytest.raises(Exception, match="display_units.stress = 'bar' is not a unit of stress; expected one of Pa"):
+        parse_deck(plate)
+    with pytest.raises(Exception, match="meta.units = 'consistent' names no units to convert from"):
+        parse_deck(PLATE.replace('precision = "double"', 'display_units = { stress = "kPa" }')
+                   .replace('title = "test scene"', 'title = "test scene"\nunits = "consistent"'))
+
+
+def test_the_carotid_plots_against_its_whole_lumen_pressure_in_mmhg():
+    """The carotid's diastolic ramp and its pulse above it are one lumen pressure on the
+    plots' load axis, shown in mmHg: 80 mmHg at 0.08 s with the pulse file's value then,
+    and the pulse's peak above 80 mmHg at the most."""
+    from shellsim.output.plots import _load_axis
+    from shellsim.output.units import DisplayUnits
+
+    deck = load_deck(ROOT / "decks" / "tissue" / "carotid_hgo_pulse.toml")
+    t = np.linspace(0.0, 2.4, 241)
+    pressure, label = _load_axis(deck, t, DisplayUnits.of(deck))
+    assert label == "pressure on 'all' (mmHg)"
+    pascals = 10.666e3 * deck.curves["diastole"](t) + deck.curves["pulse"](t)  # the pulse curve is in Pa
+    np.testing.assert_allclose(pressure, pascals / 133.322387415, rtol=1e-12)
+    csv = np.loadtxt(ROOT / "decks" / "tissue" / "carotid_pulse.csv", delimiter=",", skiprows=2)
+    # the deck's own mmHg: 10.666e3 Pa for 80 and value_scale 133.322 for the file's
+    assert pressure[8] == pytest.approx((10.666e3 + 133.322 * np.interp(0.08, *csv.T)) / 133.322387415, rel=1e-9)
+    assert pressure.max() == pytest.approx(80.0 + csv[:, 1].max(), rel=2e-3)
+
+
 def test_a_static_vtu_series_has_its_times_and_renders_and_its_summary_is_strict_json(tmp_path):
     """A static run written as VTU only: results.pvd gives every frame its load time as a
     plain number (ParaView read 'np.float64(0.1)' as 0 and showed only the first frame),

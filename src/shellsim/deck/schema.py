@@ -22,12 +22,25 @@ from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec
 
 Axis = Literal["x", "y", "z"]
 
+#: Each unit system's units of length, stress (and pressure) and time (``consistent``
+#: names none).
+SYSTEMS = {name: {"length": length, "stress": stress, "pressure": stress, "time": time}
+           for name, (length, stress, time) in {"SI": ("m", "Pa", "s"), "mm-t-s": ("mm", "MPa", "s"),
+                                                 "mm-kg-ms": ("mm", "GPa", "ms"), "in-lbf-s": ("in", "psi", "s")}.items()}
+SYSTEMS["consistent"] = {}
+#: The units a render or plot may show, by kind, each with its size in SI units. A
+#: pressure (a pressure load) may be shown in other units than the stresses.
+_STRESS_SIZES = {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9, "mmHg": 133.322387415, "psi": 6894.757293168}
+UNIT_SIZES = {"length": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254},
+              "stress": _STRESS_SIZES, "pressure": _STRESS_SIZES, "time": {"s": 1.0, "ms": 1e-3}}
+
 
 class Meta(Section):
-    """What the scene is. ``units`` is a label for printouts; nothing is converted."""
+    """What the scene is. ``units`` names the unit system the deck's numbers are in, for
+    printouts; nothing is converted."""
 
     title: Annotated[str, Field(strict=True, min_length=1)]
-    units: Literal["SI", "mm-t-s", "mm-kg-ms", "in-lbf-s", "consistent"] = "SI"
+    units: Literal[tuple(SYSTEMS)] = "SI"
     description: str = ""
     source: str = ""
 
@@ -428,7 +441,10 @@ class Output(Section):
     the shell as a solid between its faces instead of its mid-surface; ``mirror`` names the
     ``symmetry`` boundaries (by their sets) that are planes of the model's symmetry, and
     writes the model whole, reflected across them (a quarter tube as eight copies with a z
-    symmetry plane); ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop
+    symmetry plane); ``display_units`` shows lengths, stresses and times in renders and
+    plots in other units than the deck's (e.g. { length = "mm", stress = "kPa" }; pressures
+    as ``pressure = "mmHg"``; they follow the stresses' unit otherwise), the files keep the
+    deck's; ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop
     and axial stresses in (by default the material's, when they are a tube's or a
     centreline's); probes (history.csv), a valve's measures and renders."""
 
@@ -441,6 +457,7 @@ class Output(Section):
     solid: bool = False
     mirror: bool | list[str] = []
     vessel_axes: VesselAxes | None = None
+    display_units: dict[Literal[tuple(UNIT_SIZES)], str] = {}
     probe: list[Probe] = []
     render: list[Render] = []
     valve: Valve | None = None
@@ -456,6 +473,10 @@ class Output(Section):
         unwritten = sorted(drawn - set(self.fields))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
+        for kind, unit in self.display_units.items():
+            if unit not in UNIT_SIZES[kind]:
+                raise ValueError(f"display_units.{kind} = '{unit}' is not a unit of {kind}; expected one of "
+                                 f"{', '.join(UNIT_SIZES[kind])}")
         duplicates = repeated([p.name for p in self.probe])
         if duplicates:
             raise ValueError(f"probe names must be unique; repeated: {', '.join(duplicates)}")
@@ -643,6 +664,9 @@ class Deck(Section):
             problems += [f"output.fields: '{name}' is of a fibre-reinforced law's fibres, and material.model = "
                          f"'{self.material.model}' has none" for name in FIBRE_FIELDS if name in self.output.fields]
         problems += _vessel_axes_problems(self.output)
+        if self.output.display_units and self.meta.units == "consistent":
+            problems.append("output.display_units: meta.units = 'consistent' names no units to convert from; give "
+                            f"meta.units (one of {', '.join(u for u in SYSTEMS if u != 'consistent')})")
         problems += proportion_problems(self.geometry, self.section.thickness)
         if self.solver.method == "static":
             problems += [f"contact[{i}].friction = {c.friction:g}: friction opposes sliding velocities, and a static "

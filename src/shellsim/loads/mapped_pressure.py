@@ -30,7 +30,7 @@ class MappedPressure(LoadTable):
     face: Literal["bottom", "mid", "top"] = "mid"
     SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
     FEATURES: ClassVar[tuple[str, ...]] = ("follower_pressure",)
-    QUANTITY: ClassVar[str] = "stress"
+    QUANTITY: ClassVar[str] = "pressure"
 
 
 TABLES = (MappedPressure,)

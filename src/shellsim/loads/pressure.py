@@ -37,7 +37,7 @@ class Pressure(LoadTable):
     follower: bool = True
     SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
     FEATURES: ClassVar[tuple[str, ...]] = ("follower_pressure", "dead_pressure")
-    QUANTITY: ClassVar[str] = "stress"
+    QUANTITY: ClassVar[str] = "pressure"
 
     @property
     def feature(self) -> str:

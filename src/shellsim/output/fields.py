@@ -31,6 +31,7 @@ from ..loads import ToolForces
 from ..loads.cable import element_states
 from .derived import VESSEL_STRESSES, normal_components, principal_stresses, vessel_frames
 from .encoding import symmetric_columns
+from .units import NODAL_SUFFIX
 
 POINT_FIELDS = ("displacement", "director", "thickness")
 CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
@@ -40,23 +41,10 @@ PRINCIPAL, VESSEL = "principal_stress", "vessel_stress"
 #: The output field of fibre directions, written as one cell vector per family:
 #: fibre_1, fibre_2, ...; and of their stretches, fibre_stretch_1, ...
 FIBRES, FIBRE_PREFIX, FIBRE_STRETCH = "fibres", "fibre_", "fibre_stretch"
-NODAL_SUFFIX = "_nodal"
 CONTACT_PRESSURE, CONTACT_GAP = "contact_pressure", "contact_gap"
 #: Fields the shell view shows as their largest value through the thickness (a bent
 #: shell's equivalent stress peaks at its faces); the others as the thickness mean.
 LARGEST_THROUGH_THICKNESS = ("von_mises",)
-
-#: What each field or probe quantity measures, for units in titles and axis labels.
-FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
-              "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
-              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time",
-              **dict.fromkeys((*WRITTEN_AS[PRINCIPAL], *WRITTEN_AS[VESSEL]), "stress")}
-#: Units of each kind per deck unit system (meta.units); nothing is converted.
-UNITS = {"SI": {"length": "m", "area": "m^2", "stress": "Pa", "time": "s"},
-         "mm-t-s": {"length": "mm", "area": "mm^2", "stress": "MPa", "time": "s"},
-         "mm-kg-ms": {"length": "mm", "area": "mm^2", "stress": "GPa", "time": "ms"},
-         "in-lbf-s": {"length": "in", "area": "in^2", "stress": "psi", "time": "s"},
-         "consistent": {}}
 
 #: Sub-cell boundaries along r or s: the 3-point Gauss weights laid end to end.
 SUB_BOUNDS = -1.0 + np.concatenate([[0.0], np.cumsum(gauss_rule(3)[1])])
@@ -76,15 +64,6 @@ SUB_QUADS = np.array([[c, c + 1, c + 5, c + 4] for c in (4 * j + i for j in rang
 def is_fibre_direction(name: str) -> bool:
     """Whether a written array ``name`` is a fibre family's direction (fibre_1, not fibre_stretch_1)."""
     return name.startswith(FIBRE_PREFIX) and name[len(FIBRE_PREFIX):].isdigit()
-
-
-def labelled(text: str, field: str, system: str) -> str:
-    """``text`` with the unit of ``field`` (a field or probe quantity, possibly with the
-    nodal suffix, or a kind: length, stress, time) in the unit ``system`` in brackets, when
-    the system names one."""
-    name = field.removesuffix(NODAL_SUFFIX)
-    unit = UNITS.get(system, {}).get(FIELD_KIND.get(name, name), "")
-    return f"{text} ({unit})" if unit else text
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..deck.resolved import read_resolved
 from ..errors import OutputError
-from .fields import labelled
+from .units import DisplayUnits
 from .folder import output_folder
 from .history import ENERGY_COLUMNS
 
@@ -34,13 +34,18 @@ def _read(folder: Path) -> tuple[object, np.ndarray]:
     return deck, history
 
 
-def _load_axis(deck, times: np.ndarray) -> tuple[np.ndarray, str] | None:
-    """(value of the first time-curved load at ``times``, axis label), or None."""
-    for load in deck.load:
-        if getattr(load, "curve", None) and np.ndim(load.value) == 0:
-            label = f"{load.type.replace('_', ' ')} on '{load.set}'"
-            return load.value * deck.curves[load.curve](times), labelled(label, load.QUANTITY, deck.meta.units)
-    return None
+def _load_axis(deck, times: np.ndarray, units: DisplayUnits) -> tuple[np.ndarray, str] | None:
+    """(the load at ``times``, in the shown units, and the axis label), or None: the first
+    time-curved load summed with every other load of its type on the same place (a
+    vessel's diastolic pressure and the pulse above it make one lumen pressure)."""
+    curved = [load for load in deck.load if getattr(load, "curve", None) and np.ndim(load.value) == 0]
+    if not curved:
+        return None
+    first = curved[0]
+    place = lambda load: (load.type, load.set, getattr(load, "face", None))  # noqa: E731
+    total = sum(load.value * deck.curves[load.curve](times) for load in curved if place(load) == place(first))
+    label = f"{first.type.replace('_', ' ')} on '{first.set}'"
+    return units.scale(first.QUANTITY) * total, units.label(label, first.QUANTITY)
 
 
 def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
@@ -58,20 +63,22 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
 
     deck, history = _read(folder)
     out_dir = output_folder(out_dir or folder / PLOTS_DIR)
+    units = DisplayUnits.of(deck)
     times = history["time"]
-    load = _load_axis(deck, times)
+    load = _load_axis(deck, times, units)
     written = []
     valve = deck.output.valve.COLUMNS if deck.output.valve is not None else {}
     for name, quantity in [(probe.name, probe.quantity) for probe in deck.output.probe] + list(valve.items()):
         measured = ~np.isnan(history[name])  # a valve's measures are taken at some samples only
-        t, values = times[measured], history[name][measured]
+        scale = units.scale(quantity)
+        t, values = times[measured], scale * history[name][measured]
         figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")
         axes = figure.subplots(1, 2 if load else 1, squeeze=False)[0]
-        ylabel = labelled(name, quantity, deck.meta.units)
-        for ax, x, xlabel in zip(axes, (t, *((load[0][measured],) if load else ())),
-                                 (labelled("time", "time", deck.meta.units), *(load[1:] if load else ()))):
+        ylabel = units.label(name, quantity)
+        for ax, x, xlabel in zip(axes, (units.scale("time") * t, *((load[0][measured],) if load else ())),
+                                 (units.label("time", "time"), *(load[1:] if load else ()))):
             ax.plot(x, values, color="black", lw=1.4, label="shellsim")
-            _draw_references(ax, deck, name, t, x)
+            _draw_references(ax, deck, name, t, x, scale, units.scale("time") if ax is axes[0] else None)
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
@@ -82,8 +89,11 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
     return written
 
 
-def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray) -> None:
-    """The deck's references on ``probe`` over the axis ``x`` (a function of ``times``)."""
+def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray, scale: float,
+                     time_scale: float | None) -> None:
+    """The deck's references on ``probe`` over the axis ``x`` (a function of ``times``),
+    their values times ``scale`` (into the shown units); ``time_scale`` is the time's when
+    ``x`` is the time axis, None otherwise."""
     colours = iter(["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"])
     for measure in dict.fromkeys(r.measure for r in deck.reference if r.probe == probe):
         refs = [r for r in deck.reference if r.probe == probe and r.measure == measure]
@@ -91,15 +101,16 @@ def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray) -> 
         label = f"reference ({measure.replace('_', ' ')}): {refs[0].source}"
         if measure in POINT_MEASURES:
             at = [times[-1] if r.measure == "final" else r.time for r in refs]
-            ax.errorbar(np.interp(at, times, x), [r.expected for r in refs], fmt="o", color=colour, ms=5,
-                        yerr=[_tolerance(r) for r in refs], capsize=3, label=_short(label))
+            ax.errorbar(np.interp(at, times, x), [scale * r.expected for r in refs], fmt="o", color=colour, ms=5,
+                        yerr=[scale * _tolerance(r) for r in refs], capsize=3, label=_short(label))
         elif measure in LEVEL_MEASURES:
             for r in refs:
-                for level in ((r.expected, -r.expected) if measure == "max_abs" else (r.expected,)):
+                for level in ((scale * r.expected, -scale * r.expected) if measure == "max_abs"
+                              else (scale * r.expected,)):
                     ax.axhline(level, color=colour, ls="--", lw=1, label=_short(label))
-        elif measure == "first_peak_time" and x is times:
+        elif measure == "first_peak_time" and time_scale is not None:
             for r in refs:
-                ax.axvline(r.expected, color=colour, ls="--", lw=1, label=_short(label))
+                ax.axvline(time_scale * r.expected, color=colour, ls="--", lw=1, label=_short(label))
 
 
 def _tolerance(reference) -> float:
@@ -118,7 +129,8 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
 
     figure = Figure(figsize=size, layout="constrained")
     ax = figure.subplots()
-    t = history["time"]
+    units = DisplayUnits.of(deck)
+    t = units.scale("time") * history["time"]
     # what the structure holds or has lost: every energy column the history has but the external work
     kept = [name for name in ENERGY_COLUMNS if name != "external_work" and name in history.dtype.names]
     for column in kept:
@@ -127,7 +139,7 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
     balance = sum(history[column] for column in kept) - history["external_work"]
     names = " + ".join(column.split("_")[0] for column in kept)
     ax.plot(t, balance, color="black", ls=":", label=f"balance ({names} - external)")
-    ax.set_xlabel(labelled("time", "time", deck.meta.units))
+    ax.set_xlabel(units.label("time", "time"))
     ax.set_ylabel("energy")
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")

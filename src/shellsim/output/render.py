@@ -15,6 +15,7 @@ from ..element.shape import shape
 from ..errors import OutputError, ShellsimError
 from .encoding import SYMMETRIC_PAIRS
 from .folder import output_folder
+from .units import NODAL_SUFFIX, DisplayUnits
 from ..mesh import Mesh
 
 #: Points drawn along each element edge so curved edges look curved.
@@ -136,15 +137,15 @@ def field_values(point_data: dict, cell_data: dict, field: str, component: str |
     return (np.linalg.norm(values, axis=1) if column is None else values[:, column]), on_cells, component
 
 
-def _series_units(folder: Path) -> tuple[str, str]:
-    """(title, unit system) of the deck a results folder was run from, if it is there."""
+def _series_units(folder: Path) -> tuple[str, DisplayUnits]:
+    """(title, units shown) of the deck a results folder was run from, if it is there."""
     from ..deck.resolved import read_resolved
 
     try:
-        meta = read_resolved(folder).meta
+        deck = read_resolved(folder)
     except ShellsimError:  # a series without its deck is still drawn, without units
-        return "", "consistent"
-    return meta.title, meta.units
+        return "", DisplayUnits()
+    return deck.meta.title, DisplayUnits.of(deck)
 
 
 def _frame_indices(frame: str | int, count: int) -> list[int]:
@@ -189,7 +190,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     ``folder`` ('last', 'all' or a frame number), plus an animated GIF for 'all'; written
     to ``out_dir`` (default ``folder/renders``), with the ``overlays``. ``on_frame(done,
     total)`` hears of each picture written. Returns the files written."""
-    from .fields import NODAL_SUFFIX, is_fibre_direction, labelled
+    from .fields import is_fibre_direction
     from .series import CABLES, StoredSeries
 
     series = StoredSeries(folder)
@@ -197,7 +198,9 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         folder / f"{CABLES}.pvd").exists() else None
     indices = _frame_indices(frame, len(series.times))
     frames = [series.frame(i) for i in indices]
-    picked = [field_values(p, c, field, component) for p, c in frames]
+    title, units = _series_units(folder)
+    picked = [(units.scale(field) * values, on_cells, part)
+              for values, on_cells, part in (field_values(p, c, field, component) for p, c in frames)]
     # NaN marks a value that is not there (a contact gap beyond the search): drawn grey
     low = min(float(np.nanmin(v, initial=np.inf)) for v, _, _ in picked)
     high = max(float(np.nanmax(v, initial=-np.inf)) for v, _, _ in picked)
@@ -205,9 +208,8 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         low = high = 0.0
     if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
         low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
-    title, units = _series_units(folder)
     label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
-    bar = labelled(f"{label} {picked[0][2]}".strip(), field, units)
+    bar = units.label(f"{label} {picked[0][2]}".strip(), field)
     out_dir = output_folder(out_dir or folder / RENDERS_DIR)
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []
@@ -246,6 +248,8 @@ class Colouring(NamedTuple):
     limits: tuple[float, float]
 
 
+#: The fields' colour map: perceptually uniform, so equal steps in value look equal.
+COLOUR_MAP = "viridis"
 #: Colours of the fibre families' lines.
 FIBRE_COLOURS = ["black", "white", "magenta"]
 
@@ -266,7 +270,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
     field_actor = plotter.add_mesh(
-        grid, scalars="values", clim=limits, cmap="turbo", preference="cell" if on_cells else "point",
+        grid, scalars="values", clim=limits, cmap=COLOUR_MAP, preference="cell" if on_cells else "point",
         scalar_bar_args={"title": bar, "color": "black", "vertical": False, "fmt": "%.4g", "position_x": 0.2,
                          "position_y": 0.04, "width": 0.6, "height": 0.07,
                          "title_font_size": max(10, size[1] // 40), "label_font_size": max(8, size[1] // 50)})
@@ -280,14 +284,15 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
         middle = np.arange(len(series.cells)) % 9 == 4
         faces = series.cells[middle, 4:] if series.cell_type == "hexahedron" else series.cells[middle]  # top faces
         centres = points[faces].mean(axis=1)
-        length = 1.2 * np.median(np.linalg.norm(points[faces[:, 2]] - points[faces[:, 0]], axis=1))
+        # half the centre sub-cell's diagonal either way, one pixel wide: the field shows between them
+        length = 0.5 * np.median(np.linalg.norm(points[faces[:, 2]] - points[faces[:, 0]], axis=1))
         count = len(centres)
         segments = np.column_stack([np.full(count, 2), np.arange(count), np.arange(count) + count]).ravel()
         for family, every in enumerate(drawn.fibres):
             directions = every[middle]
             ends = np.concatenate([centres - length * directions, centres + length * directions])
             plotter.add_mesh(pv.PolyData(ends, lines=segments), color=FIBRE_COLOURS[family % len(FIBRE_COLOURS)],
-                             line_width=2)
+                             line_width=1)
     if drawn.cables is not None:
         at, ends = drawn.cables
         segments = np.column_stack([np.full(len(ends), 2), ends]).ravel()

@@ -1,0 +1,60 @@
+"""The units renders and plots show: the deck's unit system (``meta.units``) names each
+kind's unit, and ``output.display_units`` may show lengths, stresses and times in others
+(mm, kPa, mmHg, ms), the numbers converted for the picture only."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..deck.schema import SYSTEMS, UNIT_SIZES, WRITTEN_AS
+
+#: A field's smoothed nodal version: ``<field>_nodal``.
+NODAL_SUFFIX = "_nodal"
+#: What each field, written array or probe quantity measures.
+FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
+              "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
+              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time",
+              **dict.fromkeys((*WRITTEN_AS["principal_stress"], *WRITTEN_AS["vessel_stress"]), "stress")}
+
+
+@dataclass(frozen=True)
+class DisplayUnits:
+    """Units of a deck's unit ``system`` (SYSTEMS' keys), with the ``shown`` ones (kind:
+    unit) instead where given. A field or quantity of kind length, stress, pressure, time
+    or area (length squared) has a unit; others are drawn as they are."""
+
+    system: str = "consistent"
+    shown: dict[str, str] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, deck) -> "DisplayUnits":
+        return cls(deck.meta.units, dict(deck.output.display_units))
+
+    def _kind(self, name: str) -> tuple[str, int]:
+        """(base kind, power) of a field, quantity or kind: area is length squared."""
+        kind = FIELD_KIND.get(name.removesuffix(NODAL_SUFFIX), name.removesuffix(NODAL_SUFFIX))
+        return ("length", 2) if kind == "area" else (kind, 1)
+
+    def _shown(self, kind: str) -> str | None:
+        """The unit asked for ``kind``: a pressure's follows the stresses' unless given."""
+        return self.shown.get(kind) or (self.shown.get("stress") if kind == "pressure" else None)
+
+    def unit(self, name: str) -> str:
+        """The unit ``name`` (a field, probe quantity or kind) is shown in; '' for none."""
+        kind, power = self._kind(name)
+        unit = self._shown(kind) or SYSTEMS[self.system].get(kind, "")
+        return f"{unit}^{power}" if unit and power > 1 else unit
+
+    def scale(self, name: str) -> float:
+        """The factor taking a value of ``name`` from the deck's units to the shown ones."""
+        kind, power = self._kind(name)
+        shown = self._shown(kind)
+        if shown is None:
+            return 1.0
+        sizes = UNIT_SIZES[kind]
+        return (sizes[SYSTEMS[self.system][kind]] / sizes[shown]) ** power
+
+    def label(self, text: str, name: str) -> str:
+        """``text`` with the unit of ``name`` in brackets, where it has one."""
+        unit = self.unit(name)
+        return f"{text} ({unit})" if unit else text

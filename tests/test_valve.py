@@ -184,7 +184,8 @@ def test_the_valve_closes_under_diastolic_pressure_its_free_edges_meeting():
     free edges) and none has gone a quarter of a thickness into it; the three pairs take
     the same contact force (the valve's threefold symmetry). The leaflets' law only sets
     how far they sag: linear elastic E = 2 MPa here. Measured: 23 load steps, 138
-    iterations; gaps -0.098 h (the middles, pressed by two neighbours) to -0.031 h; each
+    iterations (139 on an AMD EPYC, where one step at 65% of the load needs the line
+    search's second try); gaps -0.098 h (the middles, pressed by two neighbours) to -0.031 h; each
     pair's force 0.5895 N to 1e-10, its coaptation area 57.4 mm^2.
 
     With one self-contact table over all three leaflets the solve stalls where the three

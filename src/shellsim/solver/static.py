@@ -101,9 +101,10 @@ class NewtonSolver:
         return norm <= floor or (norm <= settings.force_tolerance * scale
                                  and energy <= settings.energy_tolerance * energy_scale)
 
-    def step(self, t: float) -> tuple[int, int, float]:
+    def step(self, t: float, line_search: bool = False) -> tuple[int, int, float]:
         """Equilibrium at load time t from the converged state; returns (iterations,
         tangents formed, relative residual). Raises NotConverged with the reason.
+        ``line_search``: see :meth:`_line_search`.
 
         Full Newton forms the tangent at every iterate. Modified Newton keeps the last one
         (from earlier steps too) while each iteration leaves at most SLOW of the residual;
@@ -148,10 +149,21 @@ class NewtonSolver:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
             eq.move(np.concatenate([correction, pending]))
             eq.evaluate(t)
-            if fresh and not np.any(pending):
+            if line_search and fresh and not np.any(pending):
                 self._line_search(t, start, correction, norm)
             pending = np.zeros_like(known)
         raise AssertionError("unreachable")
+
+    def _step_or_search(self, t: float) -> tuple[int, int, float]:
+        """:meth:`step` to t; when it fails, again from the same start with the line search.
+        Only as a second try: where plain Newton converges the search can lead it astray
+        (two contact scenes stalled with it at their first contact)."""
+        try:
+            return self.step(t)
+        except NotConverged:
+            self.eq.converged.restore(self.run.sim)
+            self.tangent = None
+            return self.step(t, line_search=True)
 
     def _line_search(self, t: float, start: Converged, correction: np.ndarray, norm: float) -> None:
         """After a fresh tangent's ``correction`` from ``start`` (residual ``norm``) made the
@@ -159,13 +171,18 @@ class NewtonSolver:
         comes on or off, or a fibre family is recruited, the tangent at the start does not
         hold across the step, and the whole correction can overshoot to a state where every
         next one does too."""
-        for _ in range(LINE_SEARCH_HALVINGS):
-            if np.linalg.norm(self.eq.residual()[:self.n_free]) <= norm:
-                return
-            correction = 0.5 * correction
+        def moved_by(share: float) -> float:
             start.restore(self.run.sim)
-            self.eq.move(np.concatenate([correction, np.zeros(self.eq.unknowns.n_known)]))
+            self.eq.move(np.concatenate([share * correction, np.zeros(self.eq.unknowns.n_known)]))
             self.eq.evaluate(t)
+            return float(np.linalg.norm(self.eq.residual()[:self.n_free]))
+
+        if np.linalg.norm(self.eq.residual()[:self.n_free]) <= norm:
+            return
+        for halvings in range(1, LINE_SEARCH_HALVINGS + 1):
+            if moved_by(0.5 ** halvings) <= norm:
+                return
+        moved_by(1.0)  # no share lowers it: the whole correction, as without the search
 
     def held_apart(self, t: float) -> None:
         """Raises NotConverged when the equilibrium just found at load time t has contact
@@ -186,7 +203,7 @@ class NewtonSolver:
             remaining = landing - sim.state.t
             target = landing if remaining <= 1.25 * length else sim.state.t + length
             try:
-                iterations, tangents, residual = self.step(target)
+                iterations, tangents, residual = self._step_or_search(target)
                 step = NewtonStep(t=target, load_time=target, iterations=iterations, tangents=tangents,
                                   residual=residual, cutbacks=cutbacks)
                 return step, length

@@ -35,3 +35,15 @@ os.environ.setdefault("NUMBA_OPT", "1")
 os.environ.setdefault("NUMBA_CACHE_DIR", _numba_cache_dir())
 if "numba" in sys.modules:  # imported first, it has read its settings: read them again
     sys.modules["numba"].core.config.reload_config()
+
+#: The Python interface (:mod:`shellsim.api`), imported on first use: ``import shellsim``
+#: alone compiles and loads nothing.
+__all__ = ["load", "run", "Results"]
+
+
+def __getattr__(name: str):
+    if name in __all__:
+        from . import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'shellsim' has no attribute '{name}'")

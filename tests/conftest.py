@@ -132,6 +132,20 @@ against = "lower"
     return run_deck(parse_deck(text))
 
 
+#: A 2 x 1 plate's geometry and tables for deck_text: clamped along x = 0, a pressure of
+#: 0.01 on every element; the pressure's table comes last, open for a curve key.
+CLAMPED_PLATE = ('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', """
+[[boundary]]
+type = "clamped"
+set = "x0"
+
+[[load]]
+type = "pressure"
+value = 0.01
+set = "all"
+""")
+
+
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     """A valid deck: ``base`` + [geometry] body + extra tables."""
     return f"{base}\n[geometry]\n{geometry}\n{extra}"

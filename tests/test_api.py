@@ -13,18 +13,9 @@ import pytest
 import shellsim
 from shellsim.errors import DeckError, OutputError
 
-from .conftest import ROOT, deck_text
+from .conftest import CLAMPED_PLATE, ROOT, deck_text
 
-PLATE = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', """
-[[boundary]]
-type = "clamped"
-set = "x0"
-
-[[load]]
-type = "pressure"
-value = 0.01
-set = "all"
-
+PLATE = deck_text(CLAMPED_PLATE[0], CLAMPED_PLATE[1] + """
 [solver]
 method = "static"
 end_time = 1.0

@@ -29,21 +29,12 @@ from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_m
 from shellsim.output.series import check_space
 from shellsim.solver.run import Listener, integrate, output_times
 
-from .conftest import ROOT, deck_text, prepared
+from .conftest import CLAMPED_PLATE, ROOT, deck_text, prepared
 
 runner = CliRunner()
 ALL_FIELDS = ["displacement", "director", "thickness", "cauchy_stress", "lamina_stress", "pressure_band",
               "green_lagrange_strain", "von_mises"]
-PLATE = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', f"""
-[[boundary]]
-type = "clamped"
-set = "x0"
-
-[[load]]
-type = "pressure"
-value = 0.01
-set = "all"
-curve = "ramp"
+PLATE = deck_text(CLAMPED_PLATE[0], CLAMPED_PLATE[1] + f"""curve = "ramp"
 
 [curves.ramp]
 t = [0.0, 0.5]

@@ -61,14 +61,11 @@ def pytest_configure(config):
 
 
 def prepared(deck, base_dir: Path | None = None):
-    """A run of ``deck`` ready to start: mesh (a mesh file's path relative to ``base_dir``),
-    model and simulation built."""
-    from shellsim.geometry import build_mesh
-    from shellsim.model import build_model
-    from shellsim.solver.run import prepare
+    """A run of ``deck`` ready to start as ``shellsim run`` builds it: mesh (a mesh file's
+    path relative to ``base_dir``; an imaged scene's unloaded shape), model and simulation."""
+    from shellsim.execute import built_run
 
-    mesh = build_mesh(deck, base_dir)
-    return prepare(deck, mesh, build_model(deck, mesh))
+    return built_run(deck, base_dir)
 
 
 def initial_shape(model):

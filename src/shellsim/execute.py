@@ -43,12 +43,19 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
 
     clock = Stopwatch()
     mesh = sized_mesh(scene, deck_folder, announce)
+    unloading = None
+    if scene.solver.imaged is not None:
+        from .solver.unloaded import unloaded_mesh
+
+        announce(f"finding the unloaded shape of the mesh imaged at t = {scene.solver.imaged.at:g}")
+        mesh, unloading = unloaded_mesh(scene, mesh, announce)
     mesh_s = clock.lap()
     announce("building the model")
     model = build_model(scene, mesh)
     model_s = clock.lap()
     run = prepare(scene, mesh, model)
     run.startup |= {"mesh_s": mesh_s, "model_s": model_s, "kernels_s": clock.lap()}
+    run.unloading = unloading
     return run
 
 

@@ -76,6 +76,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0)}}
            if run.deck.solver.mass_scaling is not None else {}),
         **({"relaxation": run.relaxing.record(run.sim)} if run.relaxing is not None else {}),
+        **({"unloaded_shape": run.unloading.record()} if run.unloading is not None else {}),
         "reference": reference_results(run),
     }
 

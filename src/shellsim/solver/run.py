@@ -74,6 +74,7 @@ class Run:
     tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
     valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS
     relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
+    unloading: object | None = None  # finding an imaged scene's unloaded shape (unloaded.Unloading)
 
     @property
     def load_time(self) -> float:

@@ -171,13 +171,17 @@ class NewtonSolver:
         comes on or off, or a fibre family is recruited, the tangent at the start does not
         hold across the step, and the whole correction can overshoot to a state where every
         next one does too."""
+        def residual_norm() -> float:
+            with np.errstate(over="ignore", invalid="ignore"):  # a wild trial's residual is simply too large
+                return float(np.linalg.norm(self.eq.residual()[:self.n_free]))
+
         def moved_by(share: float) -> float:
             start.restore(self.run.sim)
             self.eq.move(np.concatenate([share * correction, np.zeros(self.eq.unknowns.n_known)]))
             self.eq.evaluate(t)
-            return float(np.linalg.norm(self.eq.residual()[:self.n_free]))
+            return residual_norm()
 
-        if np.linalg.norm(self.eq.residual()[:self.n_free]) <= norm:
+        if residual_norm() <= norm:
             return
         for halvings in range(1, LINE_SEARCH_HALVINGS + 1):
             if moved_by(0.5 ** halvings) <= norm:

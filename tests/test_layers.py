@@ -26,9 +26,12 @@ FLOORS = [
     {"solver"},
     {"output", "verify"},
     {"execute", "study", "bench", "imported_deck"},
-    {"cli", "__main__"},
+    {"cli", "__main__", "api"},
 ]
 FLOOR = {part: level for level, parts in enumerate(FLOORS) for part in parts}
+#: The one import that runs upward on purpose: the package's front door hands out the
+#: Python interface (shellsim.run, ...) on first use.
+FRONT_DOOR = (("__init__",), "api")
 
 
 def imported_parts(text: str, here: tuple[str, ...]) -> set[tuple[str, int]]:
@@ -63,7 +66,7 @@ def test_no_import_runs_upward():
     upward = []
     for path, here in _modules():
         for part, line in imported_parts(path.read_text(), here):
-            if FLOOR.get(part, -1) > FLOOR[here[0]]:
+            if FLOOR.get(part, -1) > FLOOR[here[0]] and (here, part) != FRONT_DOOR:
                 upward.append(f"{'/'.join(here)}.py:{line} imports {part} (floor {FLOOR[part]} above {FLOOR[here[0]]})")
     assert not upward, "\n".join(upward)
 

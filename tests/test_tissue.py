@@ -25,14 +25,14 @@ def _history(folder) -> dict[str, np.ndarray]:
 def _run_coarse(deck_name: str, overrides: dict, folder):
     """The deck with ``overrides`` run into ``folder`` (its files read beside it), with its
     renders; returns (``folder``, the run)."""
-    from shellsim.cli import _deck_renders
+    from shellsim.output.render import deck_renders
     from shellsim.execute import run_scene
 
     source = TISSUE / deck_name
     scene = variant_deck(source, overrides)
     run, _ = run_scene(scene, source, folder)
     assert run.status == "completed"
-    _deck_renders(scene, folder, quiet=True)
+    deck_renders(scene, folder)
     return folder, run
 
 

@@ -28,14 +28,14 @@ REFERENCES = [{"quantity": "orifice area", "probe": "orifice_area", "measure": m
 def closing(tmp_path_factory):
     """(run, folder): the closing valve on 8 x 6 elements a leaflet (144 in all), with its
     renders."""
-    from shellsim.cli import _deck_renders
+    from shellsim.output.render import deck_renders
     from shellsim.execute import run_scene
 
     source = VALVES / "aortic_valve_closing.toml"
     scene = variant_deck(source, COARSE | {"reference": REFERENCES})
     folder = tmp_path_factory.mktemp("closing")
     run, _ = run_scene(scene, source, folder)
-    _deck_renders(scene, folder, quiet=True)
+    deck_renders(scene, folder)
     return run, folder
 
 

@@ -40,9 +40,9 @@ def run(deck: Deck | str | Path | dict, out: str | Path, base_dir: str | Path | 
     takes) into the folder ``out``: the files and renders ``shellsim run`` writes. Returns
     its :class:`Results`; a run that ends short (unstable, not converged, interrupted)
     returns too, its ``status`` and ``summary["message"]`` telling why."""
-    from .cli import _deck_renders
     from .execute import run_scene
     from .output.folder import output_folder
+    from .output.render import deck_renders
 
     is_file = isinstance(deck, (str, Path))
     scene = deck if isinstance(deck, Deck) else load(deck, base_dir)
@@ -50,7 +50,7 @@ def run(deck: Deck | str | Path | dict, out: str | Path, base_dir: str | Path | 
     folder = output_folder(Path(out))
     current, _ = run_scene(scene, deck_path, folder)
     if renders and current.status == "completed":
-        _deck_renders(scene, folder, quiet=True)
+        deck_renders(scene, folder)
     return Results(folder)
 
 

@@ -250,7 +250,11 @@ def run(
     if current.status == "output failed":
         raise OutputError(message)
     if current.status == "completed":
-        _deck_renders(scene, folder, quiet)
+        from .output.render import deck_renders
+
+        written = deck_renders(scene, folder)
+        if not quiet:
+            _announce(written)
     if not quiet:
         out.print(_run_report(result, folder))
     if current.status in ("unstable", "not converged"):
@@ -258,17 +262,6 @@ def run(
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
-
-
-def _deck_renders(scene: Any, folder: Path, quiet: bool) -> None:
-    """The renders a deck's [[output.render]] asks for, from the series just written."""
-    from .output.render import Overlays, render_field
-
-    for picture in scene.output.render:
-        written = render_field(folder, picture.field, picture.frame, picture.view, picture.size,
-                               overlays=Overlays(picture.fibres, picture.outline))
-        if not quiet:
-            _announce(written)
 
 
 def _run_report(result: dict, folder: Path) -> Table | str:

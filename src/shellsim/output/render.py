@@ -238,6 +238,14 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     return written
 
 
+def deck_renders(scene, folder: Path) -> list[Path]:
+    """The renders a deck's [[output.render]] tables ask for, from the series in
+    ``folder``; returns the files written."""
+    return [path for picture in scene.output.render
+            for path in render_field(folder, picture.field, picture.frame, picture.view, picture.size,
+                                     overlays=Overlays(picture.fibres, picture.outline))]
+
+
 class Colouring(NamedTuple):
     """A field's values on the sub-cells (``on_cells``) or their corners, the scalar bar's
     title and its (low, high) limits."""

@@ -110,3 +110,22 @@ def test_vessel_stress_asks_for_axes_it_can_use():
     given = parse_deck(plate + '\n[output]\nfields = ["vessel_stress"]\nvessel_axes = { kind = "cylindrical" }\n')
     assert given.output.vessel_axes.kind == "cylindrical"
     assert load_deck(TEST9).output.vessel_axes is None  # borrowed only when vessel_stress is written
+
+
+def test_the_shell_view_gives_the_inner_and_outer_layers_as_the_solid_view_has_them(inflated_tube):
+    """``faces``: each field at the integration layer nearest the bottom (the inner wall)
+    and top face is the solid view's value on that layer, the principal and vessel
+    stresses included; along the cylinder the hoop stress is larger at the inner wall, as
+    in a thick tube under inner pressure (Lame)."""
+    run, _, _ = inflated_tube
+    model = run.model
+    _, shell = frame_fields(run.sim, output_mesh(model), DERIVED, run.deck.output.vessel_axes, ("bottom", "top"))
+    _, solid = frame_fields(run.sim, output_mesh(model, solid=True), DERIVED, run.deck.output.vessel_axes)
+    layers = len(model.rule.tz)
+    for name in ("cauchy_stress", "hoop_stress", "axial_stress", "principal_stress_1"):
+        by_layer = solid[name].reshape(model.n_elements, layers, 9, *solid[name].shape[1:])
+        np.testing.assert_array_equal(shell[f"{name}_bottom"], by_layer[:, 0].reshape(shell[name].shape))
+        np.testing.assert_array_equal(shell[f"{name}_top"], by_layer[:, -1].reshape(shell[name].shape))
+    view = output_mesh(model)
+    on_cylinder = view.points[view.cells].mean(axis=1)[:, 2] < 0.025  # 15 mm from the cap's bending
+    assert (shell["hoop_stress_bottom"] > shell["hoop_stress_top"])[on_cylinder].all()

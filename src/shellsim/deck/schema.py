@@ -475,7 +475,10 @@ class Output(Section):
     the shell as a solid between its faces instead of its mid-surface; ``mirror`` names the
     ``symmetry`` boundaries (by their sets) that are planes of the model's symmetry, and
     writes the model whole, reflected across them (a quarter tube as eight copies with a z
-    symmetry plane); ``display_units`` shows lengths, stresses and times in renders and
+    symmetry plane); ``faces`` adds, in the shell view, each stress and strain field at the
+    integration layer nearest the ``bottom`` face (a vessel's inner wall, its directors
+    pointing out) and the ``top`` face as ``<field>_bottom`` and ``<field>_top``;
+    ``display_units`` shows lengths, stresses and times in renders and
     plots in other units than the deck's (e.g. { length = "mm", stress = "kPa" }; pressures
     as ``pressure = "mmHg"``; they follow the stresses' unit otherwise), the files keep the
     deck's; ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop
@@ -491,6 +494,7 @@ class Output(Section):
     solid: bool = False
     mirror: bool | list[str] = []
     vessel_axes: VesselAxes | None = None
+    faces: list[Literal["bottom", "top"]] = []
     display_units: dict[Literal[tuple(UNIT_SIZES)], str] = {}
     probe: list[Probe] = []
     render: list[Render] = []

@@ -221,11 +221,32 @@ def _on_cells(values: np.ndarray, mesh: OutputMesh) -> np.ndarray:
     return np.swapaxes(values, 1, 2).reshape(len(mesh.cells), *values.shape[3:])
 
 
-def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_axes=None) -> tuple[dict, dict]:
+def _stress_measures(sim: Simulation, cauchy: np.ndarray, depths: np.ndarray, fields: list[str], vessel_axes,
+                     mesh: OutputMesh, suffix: str = "") -> dict[str, np.ndarray]:
+    """The principal and vessel stresses asked for, as cell arrays named with ``suffix``,
+    of the Cauchy stresses (ne, nq, L, 3, 3) on the view's L layers at thickness
+    coordinates ``depths`` (L,)."""
+    measures = {}
+    if PRINCIPAL in fields:
+        values, directions = principal_stresses(cauchy)
+        for k, name in enumerate(WRITTEN_AS[PRINCIPAL]):
+            measures[name + suffix] = _on_cells(values[..., k], mesh)
+            measures[f"principal_direction_{k + 1}{suffix}"] = _on_cells(directions[..., k, :], mesh)
+    if VESSEL in fields:
+        frames = vessel_frames(sim, vessel_axes, depths)
+        for name, values in zip(VESSEL_STRESSES, np.moveaxis(normal_components(cauchy, frames), -1, 0)):
+            measures[name + suffix] = _on_cells(values, mesh)
+    return measures
+
+
+def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_axes=None,
+                 faces: tuple[str, ...] = ()) -> tuple[dict, dict]:
     """(point_data, cell_data) of the current state for the requested ``fields``: arrays
     of shape (P,), (P, 3) or (P, 6) on the points, (C,), (C, 3) or (C, 6) on the cells;
     the tensors, all symmetric, as their six components (:data:`SYMMETRIC_PAIRS`);
-    ``vessel_axes`` (a tube's or centreline's axes) for ``vessel_stress``."""
+    ``vessel_axes`` (a tube's or centreline's axes) for ``vessel_stress``. In the shell
+    view, each stress and strain field also at the integration layer nearest each of the
+    ``faces`` ("bottom", "top"), as ``<name>_bottom``, ``<name>_top``."""
     model, state = sim.model, sim.state
     point_data: dict[str, np.ndarray] = {}
     if "displacement" in fields:
@@ -253,15 +274,16 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
         point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers), CORNER_HATS)
     if {PRINCIPAL, VESSEL} & set(fields):  # of each layer's stress in the solid view, of the mean in the shell view
         cauchy = tensors[1] if mesh.solid else thickness_mean(tensors[1], model.rule.wt, axis=2)[:, :, None]
-        if PRINCIPAL in fields:
-            values, directions = principal_stresses(cauchy)
-            for k, name in enumerate(WRITTEN_AS[PRINCIPAL]):
-                cell_data[name] = _on_cells(values[..., k], mesh)
-                cell_data[f"principal_direction_{k + 1}"] = _on_cells(directions[..., k, :], mesh)
-        if VESSEL in fields:
-            frames = vessel_frames(sim, vessel_axes, model.rule.tz if mesh.solid else np.zeros(1))
-            for name, values in zip(VESSEL_STRESSES, np.moveaxis(normal_components(cauchy, frames), -1, 0)):
-                cell_data[name] = _on_cells(values, mesh)
+        cell_data |= _stress_measures(sim, cauchy, model.rule.tz if mesh.solid else np.zeros(1), fields, vessel_axes,
+                                      mesh)
+    for face in () if mesh.solid else faces:  # the integration layer nearest the face
+        k = 0 if face == "bottom" else len(model.rule.tz) - 1
+        for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items():
+            flat = symmetric_columns(values) if values.ndim == 5 else values[..., None]
+            cell_data[f"{name}_{face}"] = _columns(flat[:, :, k].reshape(len(mesh.cells), -1))
+        if {PRINCIPAL, VESSEL} & set(fields):
+            cell_data |= _stress_measures(sim, tensors[1][:, :, k:k + 1], model.rule.tz[k:k + 1], fields,
+                                          vessel_axes, mesh, f"_{face}")
     if {FIBRES, FIBRE_STRETCH} & set(fields):  # every layer's in the solid view, the middle layer's in the shell view
         nt = len(model.rule.tz)
         for family, vectors in enumerate(fibre_vectors(sim, list(range(nt)) if mesh.solid else [nt // 2]), start=1):

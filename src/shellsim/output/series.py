@@ -32,7 +32,7 @@ class FrameWriter(Listener):
     """Writes every frame of a run to each format the deck's ``[output]`` asks for."""
 
     def __init__(self, folder: Path, run: Run, output: Output):
-        self.fields, self.vessel_axes = list(output.fields), output.vessel_axes
+        self.fields, self.vessel_axes, self.faces = list(output.fields), output.vessel_axes, tuple(output.faces)
         self.part = output_mesh(run.model, output.solid)
         self.copies = mirrors(mirror_planes(run.deck, run.mesh))
         self.mesh = mirrored_mesh(self.part, self.copies)
@@ -51,7 +51,7 @@ class FrameWriter(Listener):
 
     def _fields(self, run: Run) -> tuple[dict, dict]:
         """(point_data, cell_data) of the current state on the written (mirrored) mesh."""
-        point_data, cell_data = frame_fields(run.sim, self.part, self.fields, self.vessel_axes)
+        point_data, cell_data = frame_fields(run.sim, self.part, self.fields, self.vessel_axes, self.faces)
         if self.copies.count == 1:
             return point_data, cell_data
         return ({name: mirrored_values(v, self.copies) for name, v in point_data.items()},

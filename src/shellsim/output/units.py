@@ -8,8 +8,8 @@ from dataclasses import dataclass, field
 
 from ..deck.schema import SYSTEMS, UNIT_SIZES, WRITTEN_AS
 
-#: A field's smoothed nodal version: ``<field>_nodal``.
-NODAL_SUFFIX = "_nodal"
+#: A field's smoothed nodal version: ``<field>_nodal``; its values nearest a face (output.faces).
+NODAL_SUFFIX, FACE_SUFFIXES = "_nodal", ("_bottom", "_top")
 #: What each field, written array or probe quantity measures.
 FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
@@ -32,7 +32,10 @@ class DisplayUnits:
 
     def _kind(self, name: str) -> tuple[str, int]:
         """(base kind, power) of a field, quantity or kind: area is length squared."""
-        kind = FIELD_KIND.get(name.removesuffix(NODAL_SUFFIX), name.removesuffix(NODAL_SUFFIX))
+        field = name.removesuffix(NODAL_SUFFIX)
+        for suffix in FACE_SUFFIXES:
+            field = field.removesuffix(suffix)
+        kind = FIELD_KIND.get(field, field)
         return ("length", 2) if kind == "area" else (kind, 1)
 
     def _shown(self, kind: str) -> str | None:

@@ -478,12 +478,12 @@ class Output(Section):
     symmetry plane); ``faces`` adds, in the shell view, each stress and strain field at the
     integration layer nearest the ``bottom`` face (a vessel's inner wall, its directors
     pointing out) and the ``top`` face as ``<field>_bottom`` and ``<field>_top``;
-    ``display_units`` shows lengths, stresses and times in renders and
-    plots in other units than the deck's (e.g. { length = "mm", stress = "kPa" }; pressures
-    as ``pressure = "mmHg"``; they follow the stresses' unit otherwise), the files keep the
-    deck's; ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop
-    and axial stresses in (by default the material's, when they are a tube's or a
-    centreline's); probes (history.csv), a valve's measures and renders."""
+    ``display_units`` shows lengths, stresses, pressures and times in renders and plots in
+    other units than the deck's, e.g. { length = "mm", stress = "kPa", pressure = "mmHg" }
+    (pressures follow the stresses' unit unless given; the files keep the deck's units);
+    ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop and axial
+    stresses in (by default the material's, when they are a tube's or a centreline's);
+    probes (history.csv), a valve's measures and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None

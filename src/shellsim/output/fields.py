@@ -258,8 +258,9 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
         point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
     cell_data: dict[str, np.ndarray] = {}
     tensors = sim.point_tensors() if set(fields) & {*CELL_FIELDS, PRINCIPAL, VESSEL} else None
-    for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items():
-        flat = symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
+    flats = {name: symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
+             for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items()}
+    for name, flat in flats.items():
         if mesh.solid:
             cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
         else:
@@ -278,8 +279,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
                                       mesh)
     for face in () if mesh.solid else faces:  # the integration layer nearest the face
         k = 0 if face == "bottom" else len(model.rule.tz) - 1
-        for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items():
-            flat = symmetric_columns(values) if values.ndim == 5 else values[..., None]
+        for name, flat in flats.items():
             cell_data[f"{name}_{face}"] = _columns(flat[:, :, k].reshape(len(mesh.cells), -1))
         if {PRINCIPAL, VESSEL} & set(fields):
             cell_data |= _stress_measures(sim, tensors[1][:, :, k:k + 1], model.rule.tz[k:k + 1], fields,

@@ -61,14 +61,14 @@ class Results:
 
     def __init__(self, folder: str | Path):
         self.folder = Path(folder)
+        from .output.history import read_history
+
         try:
             self.summary = json.loads((self.folder / "summary.json").read_text())
-            names = (self.folder / "history.csv").read_text().splitlines()[0].split(",")
-        except (OSError, IndexError, json.JSONDecodeError) as error:
-            raise OutputError(f"'{self.folder}' holds no finished run's summary.json and history.csv: "
+        except (OSError, json.JSONDecodeError) as error:
+            raise OutputError(f"'{self.folder}' holds no finished run's summary.json: "
                               f"{getattr(error, 'strerror', None) or error}") from None
-        values = np.loadtxt(self.folder / "history.csv", delimiter=",", skiprows=1, ndmin=2)
-        self.history = {name: values[:, column] for column, name in enumerate(names)}
+        self.history = read_history(self.folder)
         self._series = None
 
     @property

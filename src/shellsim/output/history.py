@@ -6,6 +6,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import OutputError
 from ..solver.explicit import FRICTION
 from ..solver.run import Listener, Run
@@ -43,3 +45,15 @@ class HistoryWriter(Listener):
 
     def close(self) -> None:
         self._file.close()
+
+
+def read_history(folder: Path) -> dict[str, np.ndarray]:
+    """The history.csv of a run's ``folder``: column name -> (samples,) array."""
+    try:
+        table = np.genfromtxt(folder / "history.csv", delimiter=",", names=True, ndmin=1)
+    except OSError as error:
+        raise OutputError(f"'{folder}' is not a finished run's folder: {error.strerror or error} "
+                          f"({error.filename})") from None
+    if table.size == 0 or table.dtype.names is None:
+        raise OutputError(f"'{folder / 'history.csv'}' has no samples yet")
+    return {name: table[name] for name in table.dtype.names}

@@ -13,7 +13,7 @@ from ..deck.resolved import read_resolved
 from ..errors import OutputError
 from .units import DisplayUnits
 from .folder import output_folder
-from .history import ENERGY_COLUMNS
+from .history import ENERGY_COLUMNS, read_history
 
 PLOTS_DIR = "plots"
 #: How each reference measure is drawn: as points on the curve, or as a level.
@@ -21,17 +21,9 @@ POINT_MEASURES = ("at_time", "final")
 LEVEL_MEASURES = ("max", "min", "max_abs")
 
 
-def _read(folder: Path) -> tuple[object, np.ndarray]:
-    """(resolved deck, history table with named columns) of a results folder."""
-    deck = read_resolved(folder)
-    try:
-        history = np.genfromtxt(folder / "history.csv", delimiter=",", names=True, ndmin=1)
-    except OSError as error:
-        raise OutputError(f"'{folder}' is not a finished run's folder: {error.strerror or error} "
-                          f"({error.filename})") from None
-    if history.size == 0 or history.dtype.names is None:
-        raise OutputError(f"'{folder / 'history.csv'}' has no samples yet")
-    return deck, history
+def _read(folder: Path) -> tuple[object, dict[str, np.ndarray]]:
+    """(resolved deck, history columns) of a results folder."""
+    return read_resolved(folder), read_history(folder)
 
 
 def _load_axis(deck, times: np.ndarray, units: DisplayUnits) -> tuple[np.ndarray, str] | None:
@@ -124,7 +116,7 @@ def _short(text: str, limit: int = 70) -> str:
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
-def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float]) -> Path:
+def _plot_energy(deck, history: dict[str, np.ndarray], path: Path, size: tuple[float, float]) -> Path:
     from matplotlib.figure import Figure
 
     figure = Figure(figsize=size, layout="constrained")
@@ -132,7 +124,7 @@ def _plot_energy(deck, history: np.ndarray, path: Path, size: tuple[float, float
     units = DisplayUnits.of(deck)
     t = units.scale("time") * history["time"]
     # what the structure holds or has lost: every energy column the history has but the external work
-    kept = [name for name in ENERGY_COLUMNS if name != "external_work" and name in history.dtype.names]
+    kept = [name for name in ENERGY_COLUMNS if name != "external_work" and name in history]
     for column in kept:
         ax.plot(t, history[column], label=column.replace("_energy", "").replace("_", " "))
     ax.plot(t, history["external_work"], ls="--", label="external work")

@@ -138,7 +138,8 @@ class NewtonSolver:
                     eq.evaluate(t)
                 self.tangent, before = self.linearised(), None
                 tangents += 1
-            start = Converged(self.run.sim)
+            # the iterate before the correction, kept only where it may be gone back to
+            start = Converged(self.run.sim) if line_search or not fresh else None
             if not fresh:
                 before = (start, pending, residual, norm)
             previous = norm
@@ -161,9 +162,14 @@ class NewtonSolver:
         try:
             return self.step(t)
         except NotConverged:
-            self.eq.converged.restore(self.run.sim)
-            self.tangent = None
+            self._back_to_converged()
             return self.step(t, line_search=True)
+
+    def _back_to_converged(self) -> None:
+        """The last converged state again, and no tangent: one formed there may lie far
+        from the path."""
+        self.eq.converged.restore(self.run.sim)
+        self.tangent = None
 
     def _line_search(self, t: float, start: Converged, correction: np.ndarray, norm: float) -> None:
         """After a fresh tangent's ``correction`` from ``start`` (residual ``norm``) made the
@@ -212,8 +218,7 @@ class NewtonSolver:
                                   residual=residual, cutbacks=cutbacks)
                 return step, length
             except NotConverged as why:
-                self.eq.converged.restore(sim)
-                self.tangent = None  # it may have been formed far from the path
+                self._back_to_converged()
                 cutbacks += 1
                 length = min(length, remaining) * CUT
                 if length < self.settings.min_increment * end:

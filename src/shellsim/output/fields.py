@@ -262,7 +262,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
              for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items()}
     for name, flat in flats.items():
         if mesh.solid:
-            cell_data[name] = _columns(flat.transpose(0, 2, 1, 3).reshape(len(mesh.cells), -1))
+            cell_data[name] = _columns(_on_cells(flat, mesh))
         else:
             through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
             cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))

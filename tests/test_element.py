@@ -379,12 +379,13 @@ def test_mooney_rivlin_patch_follows_the_exact_homogeneous_stretches(interior, s
 
 
 #: A fibre law's deck table, one family at 30 degrees from x (Lee-Sacks; HGO's two at
-#: +-30), and its closed form's parameters.
+#: +-30, switched on smoothly), and its closed form's parameters given the family's (cos,
+#: sin).
 FIBRE_PATCH_LAWS = {
-    "hgo": ('model = "hgo"\nmu = 20e3\nk1 = 50e3\nk2 = 2.0\nkappa = 0.1\nbeta_deg = 30.0',
-            [20e3, 50e3, 2.0, 0.1]),
+    "hgo": ('model = "hgo"\nmu = 20e3\nk1 = 50e3\nk2 = 2.0\nkappa = 0.1\nbeta_deg = 30.0\nswitch_sharpness = 100.0',
+            lambda c, s: [20e3, 50e3, 2.0, 0.1, c, s, 100.0]),
     "lee_sacks": ('model = "lee_sacks"\nc0 = 10e3\nc1 = 2e3\nc2 = 4.0\nc3 = 20.0\ndelta = 0.3\nbeta_deg = 30.0',
-                  [10e3, 2e3, 4.0, 20.0, 0.3]),
+                  lambda c, s: [10e3, 2e3, 4.0, 20.0, 0.3, c, s]),
 }
 
 
@@ -401,7 +402,7 @@ def test_fibre_law_patch_follows_the_exact_homogeneous_stretches(model, interior
     table = law + '\naxes = { kind = "fixed", direction = [1.0, 0.0, 0.0] }'
     patch = square_patch(interior=interior, material=(table, ""))
     cauchy = _hgo_cauchy if model == "hgo" else _lee_sacks_cauchy
-    params = np.array(constants + [np.cos(np.radians(30.0)), np.sin(np.radians(30.0))])
+    params = np.array(constants(np.cos(np.radians(30.0)), np.sin(np.radians(30.0))))
     for l1, l2 in ((1.3, 1.1), (1.4, 0.8), (1.2, 1.2)):
         stress, h = hyperelastic_state(patch, patch.x0 * [l1, l2, 1.0], patch.d0, patch.e1f0)
         s11, s22, s12 = cauchy(params, l1, l2)

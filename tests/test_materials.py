@@ -19,17 +19,22 @@ PARAMETERS = {
     "mooney_rivlin": np.array([0.2e6, 0.05e6]),
     "neo_hookean": np.array([0.3e6, 0.0]),
     "guccione": np.array([25e3, 20.0, 10.0, 10.0]),
-    "hgo": np.array([20e3, 50e3, 2.0, 0.1, np.cos(0.6), np.sin(0.6)]),
+    "hgo": np.array([20e3, 50e3, 2.0, 0.1, np.cos(0.6), np.sin(0.6), 0.0]),
+    "hgo_switched": np.array([20e3, 50e3, 2.0, 0.1, np.cos(0.6), np.sin(0.6), 100.0]),
     "lee_sacks": np.array([10e3, 2e3, 4.0, 20.0, 0.3, np.cos(0.6), np.sin(0.6)]),
     "linear_elastic": np.array([577.0, 385.0, 5.0 / 6.0]),
 }
+#: The deck models of the :data:`PARAMETERS` cases not named by their model: HGO with the
+#: smooth fibre switch of svMultiPhysics (k = 100).
+MODEL_OF = {"hgo_switched": "hgo"}
 
 
-def material(model: str) -> Material:
-    """The kernels' bundle for the law serving ``model`` with :data:`PARAMETERS`."""
-    code, law = law_of(model)
+def material(case: str) -> Material:
+    """The kernels' bundle for the law serving the model of ``case`` with its
+    :data:`PARAMETERS`."""
+    code, law = law_of(MODEL_OF.get(case, case))
     return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=False, law=code,
-                    params=PARAMETERS[model], incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)),
+                    params=PARAMETERS[case], incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)),
                     C=np.zeros((5, 5)), normal_ratio=0.0)
 
 
@@ -147,14 +152,19 @@ def _hgo_cauchy(params: np.ndarray, l1: float, l2: float) -> tuple[float, float,
     """Cauchy sigma_11, sigma_22, sigma_12 of incompressible HGO under F = diag(l1, l2,
     1/(l1 l2)) with sigma_33 = 0 (Gasser, Ogden & Holzapfel 2006, Eq 2.8 with the pressure
     of the free normal): sigma = -p I + 2 W1 B + sum_f 2 W4f (F a_f)(F a_f), W1 = mu/2 +
-    sum_f kappa psi_f, W4f = (1 - 3 kappa) psi_f, psi_f = k1 Ebar exp(k2 Ebar^2) when
-    I4 > 1; the two families' shears cancel."""
-    mu, k1, k2, kappa, c, s = params
+    sum_f chi kappa psi_f, W4f = chi (1 - 3 kappa) psi_f + chi' Phi_f, psi_f = k1 Ebar
+    exp(k2 Ebar^2) = dPhi_f/dEbar, Phi_f = k1/(2 k2) (exp(k2 Ebar^2) - 1); chi(I4) the
+    family's switch, the step I4 > 1 or 1 / (1 + exp(-k (I4 - 1))); the two families'
+    shears cancel."""
+    mu, k1, k2, kappa, c, s, k = params
     l3 = 1.0 / (l1 * l2)
     I1, I4 = l1**2 + l2**2 + l3**2, (l1 * c) ** 2 + (l2 * s) ** 2
     ebar = kappa * (I1 - 3) + (1 - 3 * kappa) * (I4 - 1)
-    psi = k1 * ebar * np.exp(k2 * ebar**2) if I4 > 1 else 0.0
-    W1, W4 = mu / 2 + 2 * kappa * psi, 2 * (1 - 3 * kappa) * psi  # summed over the two families
+    psi, phi = k1 * ebar * np.exp(k2 * ebar**2), k1 / (2 * k2) * np.expm1(k2 * ebar**2)
+    chi = float(I4 > 1) if k == 0 else 1 / (1 + np.exp(-k * (I4 - 1)))
+    dchi = k * chi * (1 - chi)
+    W1 = mu / 2 + 2 * kappa * chi * psi  # summed over the two families
+    W4 = 2 * ((1 - 3 * kappa) * chi * psi + dchi * phi)
     return 2 * W1 * (l1**2 - l3**2) + 2 * W4 * (l1 * c) ** 2, 2 * W1 * (l2**2 - l3**2) + 2 * W4 * (l2 * s) ** 2, 0.0
 
 
@@ -174,11 +184,13 @@ def _lee_sacks_cauchy(params: np.ndarray, l1: float, l2: float) -> tuple[float, 
 
 #: (model, its parameters with the fibre angle given, the closed-form Cauchy stress)
 #: of each law with a fibre family; the variants are HGO's aligned and dispersed
-#: fibres (kappa = 0.226, the adventitia of Gasser et al. 2006) and Lee-Sacks' stiffening
-#: shared mostly by the fibres or mostly by the matrix.
+#: fibres (kappa = 0.226, the adventitia of Gasser et al. 2006), sharply or smoothly
+#: switched (k = 100), and Lee-Sacks' stiffening shared mostly by the fibres or mostly by
+#: the matrix.
 FIBRE_LAWS = {
-    "hgo_aligned": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.0, c, s], _hgo_cauchy),
-    "hgo_dispersed": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.226, c, s], _hgo_cauchy),
+    "hgo_aligned": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.0, c, s, 0.0], _hgo_cauchy),
+    "hgo_dispersed": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.226, c, s, 0.0], _hgo_cauchy),
+    "hgo_dispersed_switched": ("hgo", lambda c, s: [20e3, 50e3, 2.0, 0.226, c, s, 100.0], _hgo_cauchy),
     "lee_sacks_fibres": ("lee_sacks", lambda c, s: [10e3, 2e3, 4.0, 20.0, 0.2, c, s], _lee_sacks_cauchy),
     "lee_sacks_matrix": ("lee_sacks", lambda c, s: [10e3, 2e3, 4.0, 20.0, 0.8, c, s], _lee_sacks_cauchy),
 }

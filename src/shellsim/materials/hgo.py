@@ -14,8 +14,22 @@ H_f = kappa I + (1 - 3 kappa) a_f a_f, so with psi_f = k1 Ebar_f exp(k2 Ebar_f^2
     S^w = mu I + sum_f 2 psi_f H_f,
     CC^w : dE = sum_f 4 k1 exp(k2 Ebar_f^2) (1 + 2 k2 Ebar_f^2) (H_f : dE) H_f.
 
-Parameters (mu, k1 [stress], k2, kappa [-], cos beta, sin beta). Arrays (3, 3, G) carry one
-strain per lane of an element group (:mod:`shellsim.element.lanes`).
+With kappa > 0 the sharp exclusion makes the energy itself jump where I4 crosses 1 (Ebar
+= kappa (I1 - 3) there), and with k1 >> mu the stiffness jumps a hundredfold: Newton then
+cycles between a family's two states. ``switch_sharpness`` k replaces the exclusion by the
+smooth step chi = 1 / (1 + exp(-k (I4 - 1))) of svMultiPhysics' Holzapfel-Ogden law
+(svFSI issue 55; k = 100 there), W_f = chi Phi_f, Phi_f = k1/(2 k2) (exp(k2 Ebar_f^2) - 1).
+With x_f = I4_f - 1 = 2 A_f : E, A_f = a_f a_f,
+
+    S_f = 2 chi' Phi_f A_f + 2 chi psi_f H_f,
+    CC_f : dE = 2 (chi'' Phi_f dx + chi' psi_f dEbar) A_f + 2 (chi' psi_f dx + chi dpsi_f) H_f,
+
+dx = 2 A_f : dE, dEbar = 2 H_f : dE, dpsi_f = k1 exp(k2 Ebar^2) (1 + 2 k2 Ebar^2) dEbar,
+chi' = k chi (1 - chi), chi'' = k chi' (1 - 2 chi).
+
+Parameters (mu, k1 [stress], k2, kappa [-], cos beta, sin beta, k [-], 0 for the sharp
+exclusion). Arrays (3, 3, G) carry one strain per lane of an element group
+(:mod:`shellsim.element.lanes`).
 """
 
 from __future__ import annotations
@@ -38,7 +52,9 @@ class HolzapfelGasserOgden(AnisotropicLaw):
     (exp(k2 Ebar^2) - 1), Ebar = kappa (I1 - 3) + (1 - 3 kappa) (I4 - 1); the families at
     +-``beta_deg`` from material axis 1 (e.g. circumferential) toward axis 2, in the
     lamina; ``kappa`` the dispersion, 0 (aligned) to 1/3 (isotropic). A family in
-    compression (I4 <= 1) carries no load."""
+    compression (I4 <= 1) carries no load; with ``switch_sharpness`` k it is switched on
+    smoothly instead, by 1 / (1 + exp(-k (I4 - 1))) (svMultiPhysics' smooth step, k = 100
+    there), which static Newton needs when k1 >> mu or kappa > 0."""
 
     model: Literal["hgo"]
     mu: Positive
@@ -46,6 +62,7 @@ class HolzapfelGasserOgden(AnisotropicLaw):
     k2: Positive
     kappa: NonNegative = 0.0
     beta_deg: Real = Field(ge=0.0, le=90.0)
+    switch_sharpness: Positive | None = None
     density: Positive
     axes: Axes
 
@@ -62,9 +79,11 @@ MODELS = (HolzapfelGasserOgden,)
 
 
 def parameters(material) -> np.ndarray:
-    """(mu, k1, k2, kappa, cos beta, sin beta) of a deck's HGO ``[material]``."""
+    """(mu, k1, k2, kappa, cos beta, sin beta, switch sharpness or 0) of a deck's HGO
+    ``[material]``."""
     beta = math.radians(material.beta_deg)
-    return np.array([material.mu, material.k1, material.k2, material.kappa, math.cos(beta), math.sin(beta)])
+    return np.array([material.mu, material.k1, material.k2, material.kappa, math.cos(beta), math.sin(beta),
+                     material.switch_sharpness or 0.0])
 
 
 def fibres(params) -> np.ndarray:
@@ -90,35 +109,56 @@ def _structure(params, family, H):
 
 @njit(cache=True, error_model="numpy")
 def _fibre_strain(a0, a1, H, E, lane):
-    """(Ebar = 2 H : E, whether the family along (a0, a1, 0) is stretched) of lane ``lane``
-    of E (3, 3, G)."""
-    stretched = a0 * a0 * E[0, 0, lane] + a1 * a1 * E[1, 1, lane] + 2.0 * a0 * a1 * E[0, 1, lane] > 0.0
+    """(Ebar = 2 H : E, x = I4 - 1 = 2 a.E a) of the family along (a0, a1, 0) at lane
+    ``lane`` of E (3, 3, G); of a strain change dE, (dEbar, dx)."""
     ebar = 0.0
     for i in range(3):
         for j in range(3):
-            ebar += 2.0 * H[i, j] * E[i, j, lane]
-    return ebar, stretched
+            ebar += H[i, j] * E[i, j, lane]
+    along = a0 * a0 * E[0, 0, lane] + a1 * a1 * E[1, 1, lane] + 2.0 * a0 * a1 * E[0, 1, lane]
+    return 2.0 * ebar, 2.0 * along
+
+
+@njit(cache=True, error_model="numpy")
+def _add_along(a0, a1, factor, S, lane):
+    """S[:, :, lane] += factor A, A = a a the family's structure along (a0, a1, 0)."""
+    S[0, 0, lane] += factor * a0 * a0
+    S[1, 1, lane] += factor * a1 * a1
+    S[0, 1, lane] += factor * a0 * a1
+    S[1, 0, lane] += factor * a0 * a1
+
+
+@njit(cache=True, error_model="numpy")
+def _switch(sharpness, x):
+    """(chi, chi', chi'') of the family's switch at x = I4 - 1: the step x > 0 when
+    ``sharpness`` is 0, else 1 / (1 + exp(-sharpness x)) and its derivatives in x."""
+    if sharpness == 0.0:
+        return (1.0 if x > 0.0 else 0.0), 0.0, 0.0
+    chi = 1.0 / (1.0 + np.exp(-sharpness * x))  # exp overflows to inf far in compression: chi = 0
+    dchi = sharpness * chi * (1.0 - chi)
+    return chi, dchi, sharpness * dchi * (1.0 - 2.0 * chi)
 
 
 @njit(cache=True, error_model="numpy")
 def energy(params, E, W):
     """W (G,) of the strains E (3, 3, G)."""
-    mu, k1, k2 = params[0], params[1], params[2]
+    mu, k1, k2, sharpness = params[0], params[1], params[2], params[6]
     H = np.empty((3, 3))
     for lane in range(LANES):
         W[lane] = mu * (E[0, 0, lane] + E[1, 1, lane] + E[2, 2, lane])
     for family in range(2):
         a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
-            if stretched:
-                W[lane] += k1 / (2.0 * k2) * (np.exp(k2 * ebar * ebar) - 1.0)
+            ebar, x = _fibre_strain(a0, a1, H, E, lane)
+            chi = _switch(sharpness, x)[0]
+            if chi > 0.0:
+                W[lane] += chi * k1 / (2.0 * k2) * (np.exp(k2 * ebar * ebar) - 1.0)
 
 
 @njit(cache=True, error_model="numpy")
 def energy_stress(params, E, S):
     """S^w (3, 3, G) = dW/dE at E (3, 3, G)."""
-    mu, k1, k2 = params[0], params[1], params[2]
+    mu, k1, k2, sharpness = params[0], params[1], params[2], params[6]
     H = np.empty((3, 3))
     S[:] = 0.0
     for i in range(3):
@@ -126,30 +166,38 @@ def energy_stress(params, E, S):
     for family in range(2):
         a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
-            if stretched:
-                psi = k1 * ebar * np.exp(k2 * ebar * ebar)
+            ebar, x = _fibre_strain(a0, a1, H, E, lane)
+            chi, dchi, _ = _switch(sharpness, x)
+            if chi > 0.0:
+                growth = np.exp(k2 * ebar * ebar)
+                psi = k1 * ebar * growth
                 for i in range(3):
                     for j in range(3):
-                        S[i, j, lane] += 2.0 * psi * H[i, j]
+                        S[i, j, lane] += 2.0 * chi * psi * H[i, j]
+                if sharpness > 0.0:  # the smooth switch's own share, along the family
+                    _add_along(a0, a1, 2.0 * dchi * k1 / (2.0 * k2) * (growth - 1.0), S, lane)
 
 
 @njit(cache=True, error_model="numpy")
 def energy_tangent(params, E, dE, dS):
     """dS^w (3, 3, G) = CC^w : dE at E, dE (3, 3, G)."""
-    k1, k2 = params[1], params[2]
+    k1, k2, sharpness = params[1], params[2], params[6]
     H = np.empty((3, 3))
     dS[:] = 0.0
     for family in range(2):
         a0, a1 = _structure(params, family, H)
         for lane in range(LANES):
-            ebar, stretched = _fibre_strain(a0, a1, H, E, lane)
-            if stretched:
-                dEbar = 0.0
+            ebar, x = _fibre_strain(a0, a1, H, E, lane)
+            chi, dchi, ddchi = _switch(sharpness, x)
+            if chi > 0.0:
+                growth = np.exp(k2 * ebar * ebar)
+                dEbar, dx = _fibre_strain(a0, a1, H, dE, lane)
+                psi = k1 * ebar * growth
+                dpsi = k1 * growth * (1.0 + 2.0 * k2 * ebar * ebar) * dEbar
+                on_H = 2.0 * (chi * dpsi + dchi * psi * dx)
                 for i in range(3):
                     for j in range(3):
-                        dEbar += 2.0 * H[i, j] * dE[i, j, lane]
-                dpsi = k1 * np.exp(k2 * ebar * ebar) * (1.0 + 2.0 * k2 * ebar * ebar) * dEbar
-                for i in range(3):
-                    for j in range(3):
-                        dS[i, j, lane] += 2.0 * dpsi * H[i, j]
+                        dS[i, j, lane] += on_H * H[i, j]
+                if sharpness > 0.0:  # the smooth switch's own share, along the family
+                    phi = k1 / (2.0 * k2) * (growth - 1.0)
+                    _add_along(a0, a1, 2.0 * (ddchi * phi * dx + dchi * psi * dEbar), dS, lane)

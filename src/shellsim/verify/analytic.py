@@ -49,27 +49,33 @@ class Guccione:
 @dataclass(frozen=True)
 class HolzapfelGasserOgden:
     """W = mu/2 (I1 - 3) + sum over the families at +-beta_deg from the circumferential
-    direction of k1/(2 k2) (exp(k2 Ebar^2) - 1), Ebar = kappa (I1 - 3) + (1 - 3 kappa)
-    (I4 - 1), a family carrying nothing while I4 <= 1 (Gasser, Ogden & Holzapfel 2006)."""
+    direction of chi(I4) k1/(2 k2) (exp(k2 Ebar^2) - 1), Ebar = kappa (I1 - 3) + (1 - 3
+    kappa) (I4 - 1), chi the step I4 > 1 (a family carrying nothing while I4 <= 1; Gasser,
+    Ogden & Holzapfel 2006) or, with ``switch_sharpness`` k, 1 / (1 + exp(-k (I4 - 1)))."""
 
     mu: float
     k1: float
     k2: float
     kappa: float
     beta_deg: float
+    switch_sharpness: float = 0.0
 
     @property
     def scale(self) -> float:
         return self.mu
 
     def stresses(self, E_t, E_z, E_r):
-        """(S_tt, S_zz, S_rr) = mu I + sum_f 2 psi (kappa I + (1 - 3 kappa) a_f a_f) at the
-        principal strains; both families stretch alike, psi = k1 Ebar exp(k2 Ebar^2)."""
+        """(S_tt, S_zz, S_rr) = mu I + sum_f [2 chi psi (kappa I + (1 - 3 kappa) a_f a_f)
+        + 2 chi' Phi a_f a_f] at the principal strains; both families stretch alike, psi =
+        k1 Ebar exp(k2 Ebar^2), Phi = k1/(2 k2) (exp(k2 Ebar^2) - 1), chi' = dchi/dI4."""
         c, s = np.cos(np.radians(self.beta_deg)), np.sin(np.radians(self.beta_deg))
         fibre = c * c * E_t + s * s * E_z  # a.E a = (I4 - 1) / 2
         ebar = 2.0 * self.kappa * (E_t + E_z + E_r) + 2.0 * (1.0 - 3.0 * self.kappa) * fibre
-        psi = np.where(fibre > 0.0, self.k1 * ebar * np.exp(self.k2 * ebar**2), 0.0)
-        dispersed, aligned = 4.0 * psi * self.kappa, 4.0 * psi * (1.0 - 3.0 * self.kappa)
+        k = self.switch_sharpness
+        chi = np.where(fibre > 0.0, 1.0, 0.0) if k == 0.0 else 1.0 / (1.0 + np.exp(-2.0 * k * fibre))
+        psi = chi * self.k1 * ebar * np.exp(self.k2 * ebar**2)
+        own = k * chi * (1.0 - chi) * self.k1 / (2.0 * self.k2) * np.expm1(self.k2 * ebar**2)
+        dispersed, aligned = 4.0 * psi * self.kappa, 4.0 * (psi * (1.0 - 3.0 * self.kappa) + own)
         return (self.mu + dispersed + aligned * c * c, self.mu + dispersed + aligned * s * s,
                 self.mu + dispersed)
 

@@ -28,6 +28,11 @@ CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
 SLOW = 0.5
 #: Halvings a correction from a fresh tangent may take while it makes the residual larger.
 LINE_SEARCH_HALVINGS = 4
+#: An iterate whose force scale (its internal forces, supports' included) is more than this
+#: many times the one its load step started from ran away: an exponential law far out
+#: (k2 = 524.6 puts forces near 1e180) can balance a pressure to 1e-6 of forces that large
+#: and pass as converged. Steps that prescribe motion are not held to it.
+RUNAWAY = 1e6
 
 
 @dataclass
@@ -110,6 +115,13 @@ class NewtonSolver:
         (from earlier steps too) while each iteration leaves at most SLOW of the residual;
         when one leaves more it forms a new tangent there, or, when that iteration made the
         residual larger, goes back to the iterate before it and forms the tangent there."""
+        # a wild iterate (an exponential law far out) has forces whose squares overflow: it is
+        # no equilibrium, and is gone back from or cut back, so numpy need not warn of it
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self._iterate(t, line_search)
+
+    def _iterate(self, t: float, line_search: bool) -> tuple[int, int, float]:
+        """:meth:`step`'s iterations."""
         eq, settings, n_free = self.eq, self.settings, self.n_free
         eq.evaluate(t)
         known = eq.prescribed_increments(t)
@@ -119,17 +131,20 @@ class NewtonSolver:
             residual = self.free_residual()
             scale = eq.force_scale()
             norm = float(np.linalg.norm(residual))
-            if iteration == 0 and not np.any(known) and norm <= settings.force_tolerance * scale:
-                return 0, 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
-            if iteration > 0:
+            if iteration == 0:
+                if not np.any(known) and norm <= settings.force_tolerance * scale:
+                    return 0, 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
+                runaway = RUNAWAY * scale if scale > 0.0 and not np.any(known) else np.inf
+            else:
                 # the energy of the next correction, with the last factorisation
                 energy = abs(float(self.tangent[1].solve(residual) @ residual))
-                if self.converged(norm, scale, energy, first_energy, self.tangent[2]):
+                if scale <= runaway and self.converged(norm, scale, energy, first_energy, self.tangent[2]):
                     self.held_apart(t)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
-                                   "of the force scale")
+                                   "of the force scale" + (f", and forces {scale / runaway * RUNAWAY:.3g} times "
+                                                           "those the step started from" if scale > runaway else ""))
             fresh = self.tangent is None or settings.newton == "full" or norm > SLOW * previous
             if fresh:
                 if before is not None and norm > previous:  # an old tangent led away: undo its correction
@@ -178,8 +193,7 @@ class NewtonSolver:
         hold across the step, and the whole correction can overshoot to a state where every
         next one does too."""
         def residual_norm() -> float:
-            with np.errstate(over="ignore", invalid="ignore"):  # a wild trial's residual is simply too large
-                return float(np.linalg.norm(self.eq.residual()[:self.n_free]))
+            return float(np.linalg.norm(self.eq.residual()[:self.n_free]))
 
         def moved_by(share: float) -> float:
             start.restore(self.run.sim)

@@ -129,3 +129,49 @@ def test_the_shell_view_gives_the_inner_and_outer_layers_as_the_solid_view_has_t
     view = output_mesh(model)
     on_cylinder = view.points[view.cells].mean(axis=1)[:, 2] < 0.025  # 15 mm from the cap's bending
     assert (shell["hoop_stress_bottom"] > shell["hoop_stress_top"])[on_cylinder].all()
+
+
+def test_pk2_and_material_stresses_are_the_closed_form_and_turn_with_the_material():
+    """A flat HGO sheet (families at +-30 degrees from its material axis 1 along x)
+    stretched homogeneously by 1.2 x 0.9, its thickness 1 / (1.2 x 0.9) of the initial
+    (incompressible): at every point of both views ``pk2_stress`` is the closed form's
+    S = F^-1 sigma F^-T in material axes (tests/test_materials.py, sigma_33 = 0) and
+    ``material_stress`` its sigma. Turned rigidly by 40 degrees about z and 25 about x
+    after stretching, both stay as they were to round-off while ``cauchy_stress`` turns."""
+    from scipy.spatial.transform import Rotation
+
+    from .test_materials import _hgo_cauchy
+
+    material = ('[material]\nmodel = "hgo"\nmu = 10.0\nk1 = 20.0\nk2 = 5.0\nkappa = 0.1\nbeta_deg = 30.0\ndensity = 1.0\n'
+                'axes = { kind = "fixed", direction = [1.0, 0.0, 0.0] }\n')
+    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace(
+        '[material]\nmodel = "linear_elastic"\nE = 1000.0\nnu = 0.3\ndensity = 1.0\n', material)
+    run = prepared(parse_deck(text))
+    beta = np.radians(30.0)
+    s11, s22, _ = _hgo_cauchy([10.0, 20.0, 5.0, 0.1, np.cos(beta), np.sin(beta), 0.0], 1.2, 0.9)
+    pk2 = np.array([s11 / 1.2**2, s22 / 0.9**2, 0.0, 0.0, 0.0, 0.0])
+    sigma = np.array([s11, s22, 0.0, 0.0, 0.0, 0.0])
+    fields = ["cauchy_stress", "pk2_stress", "material_stress"]
+    turn = Rotation.from_euler("zx", [40.0, 25.0], degrees=True).as_matrix()
+    for rotation in (np.eye(3), turn):
+        run.sim.state.x[:] = (run.model.x0 * [1.2, 0.9, 1.0]) @ rotation.T
+        run.sim.state.d[:] = run.model.d0 @ rotation.T
+        run.sim.state.h[:] = run.model.h0 / (1.2 * 0.9)
+        run.sim.evaluate_forces()
+        for solid in (False, True):
+            _, cells = frame_fields(run.sim, output_mesh(run.model, solid), fields)
+            np.testing.assert_allclose(cells["pk2_stress"], np.broadcast_to(pk2, cells["pk2_stress"].shape),
+                                       rtol=1e-9, atol=1e-9 * abs(pk2).max())
+            np.testing.assert_allclose(cells["material_stress"], np.broadcast_to(sigma, cells["material_stress"].shape),
+                                       rtol=1e-9, atol=1e-9 * abs(sigma).max())
+            turned = rotation @ np.diag(sigma[:3]) @ rotation.T
+            np.testing.assert_allclose(symmetric_tensors(cells["cauchy_stress"]),
+                                       np.broadcast_to(turned, (len(cells["cauchy_stress"]), 3, 3)),
+                                       atol=1e-9 * abs(sigma).max())
+
+
+def test_material_axes_fields_ask_for_a_hyperelastic_material():
+    plate = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0')
+    assert ("'pk2_stress' is in the axes of a hyperelastic material (section.technique = 1), and material.model = "
+            "'linear_elastic' with section.technique = None has none") in problems_of(
+        plate + '\n[output]\nfields = ["pk2_stress"]\n')

@@ -328,12 +328,14 @@ class Solver(Section):
 OutputField = Literal[
     "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
     "pressure_band", "green_lagrange_strain", "von_mises", "principal_stress", "vessel_stress", "fibres",
-    "fibre_stretch", "contact_pressure", "contact_gap",
+    "fibre_stretch", "contact_pressure", "contact_gap", "pk2_stress", "material_stress",
 ]
 #: The axes a vessel's stresses are read in: a tube's or a curved vessel's.
 VesselAxes = Annotated[Union[CylindricalAxes, CentrelineAxes], Field(discriminator="kind")]
 #: Fields a fibre-reinforced law alone has.
 FIBRE_FIELDS = ("fibres", "fibre_stretch")
+#: Fields in the material's axes, which a hyperelastic law (Technique 1) alone has.
+MATERIAL_AXES_FIELDS = ("pk2_stress", "material_stress")
 #: The scalar arrays a field writes under other names, by the field (a render draws them).
 WRITTEN_AS = {"principal_stress": tuple(f"principal_stress_{k}" for k in (1, 2, 3)),
               "vessel_stress": ("hoop_stress", "axial_stress", "radial_stress"),
@@ -701,6 +703,11 @@ class Deck(Section):
         if not self.material.ANISOTROPIC:
             problems += [f"output.fields: '{name}' is of a fibre-reinforced law's fibres, and material.model = "
                          f"'{self.material.model}' has none" for name in FIBRE_FIELDS if name in self.output.fields]
+        if self.section.technique != 1:
+            problems += [f"output.fields: '{name}' is in the axes of a hyperelastic material (section.technique = 1), "
+                         f"and material.model = '{self.material.model}' with section.technique = "
+                         f"{self.section.technique} has none" for name in MATERIAL_AXES_FIELDS
+                         if name in self.output.fields]
         problems += _vessel_axes_problems(self.output)
         if self.output.display_units and self.meta.units == "consistent":
             problems.append("output.display_units: meta.units = 'consistent' names no units to convert from; give "

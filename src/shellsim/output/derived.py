@@ -1,6 +1,7 @@
 """Fields derived from the stress and the fibres, the ones a tissue engineer plots first:
 principal stresses and their directions, the stress in a vessel's axes (hoop, axial,
-radial), each fibre family's stretch."""
+radial) and in the material's, the second Piola-Kirchhoff stress, each fibre family's
+stretch."""
 
 from __future__ import annotations
 
@@ -41,3 +42,33 @@ def vessel_frames(sim: Simulation, axes, depths: np.ndarray) -> np.ndarray:
 def normal_components(sigma: np.ndarray, frames: np.ndarray) -> np.ndarray:
     """(..., 3) a_i . sigma a_i of stresses (..., 3, 3) for the rows a_i of ``frames`` (..., 3, 3)."""
     return np.einsum("...ij,...jk,...ik->...i", frames, sigma, frames)
+
+
+def deformation_gradients(sim: Simulation, layers: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """(F, jac), each (ne, nq, len(layers), 3, 3), at the in-plane integration points of
+    the ``layers`` (indices into the thickness rule): the current Jacobian jac = dx/d(r, s,
+    t) and the deformation gradient F = jac (dX/d(r, s, t))^-1."""
+    model, state, rule = sim.model, sim.state, sim.model.rule
+    nq = len(rule.wq)
+    F, jac = (np.empty((model.n_elements, nq, len(layers), 3, 3)) for _ in range(2))
+    for column, k in enumerate(layers):
+        jac[:, :, column] = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq],
+                                           rule.dNs[:nq], rule.tz[k])[1]
+        F[:, :, column] = jac[:, :, column] @ model.body.jac0_inv[:, :nq, k]
+    return F, jac
+
+
+def second_piola_in(frames0: np.ndarray, F: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) the second Piola-Kirchhoff stress S = J F^-1 sigma F^-T of Cauchy
+    stresses sigma (..., 3, 3) at deformation gradients F (..., 3, 3), in the initial
+    frames ``frames0`` (..., 3, 3; rows the axes): S_ij = a_i . S a_j."""
+    F_inv = np.linalg.inv(F)
+    S = np.linalg.det(F)[..., None, None] * F_inv @ sigma @ np.swapaxes(F_inv, -1, -2)
+    return frames0 @ S @ np.swapaxes(frames0, -1, -2)
+
+
+def current_material_frames(frames0: np.ndarray, F: np.ndarray, jac: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) the material frames carried to the current shape, rows (a1, a2, a3):
+    a1 the initial axis 1 (row 0 of ``frames0``) carried by F and laid on the current
+    lamina of Jacobians ``jac``, a3 that lamina's normal (:func:`~shellsim.model.lamina_axes`)."""
+    return lamina_axes(jac, np.einsum("...ij,...j->...i", F, frames0[..., 0, :]))

@@ -24,17 +24,22 @@ from ..deck.schema import WRITTEN_AS
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import NODE_RS, gauss_rule, shape
 from ..materials.laws import LAWS
-from ..mesh import layer_geometry, node_areas
+from ..mesh import node_areas
 from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
 from ..loads.cable import element_states
-from .derived import VESSEL_STRESSES, normal_components, principal_stresses, vessel_frames
+from .derived import (VESSEL_STRESSES, current_material_frames, deformation_gradients, normal_components,
+                      principal_stresses, second_piola_in, vessel_frames)
 from .encoding import symmetric_columns
 from .units import NODAL_SUFFIX
 
 POINT_FIELDS = ("displacement", "director", "thickness")
-CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises")
+CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises", "pk2_stress",
+               "material_stress")
+#: Tensor fields in the material's axes: the second Piola-Kirchhoff stress in the initial
+#: ones, the Cauchy stress in the current ones.
+PK2, MATERIAL_STRESS = "pk2_stress", "material_stress"
 #: Fields derived from the Cauchy stress, cells only: principal_stress_k and
 #: principal_direction_k (k = 1, 2, 3, largest first); hoop_, axial_ and radial_stress.
 PRINCIPAL, VESSEL = "principal_stress", "vessel_stress"
@@ -163,7 +168,7 @@ def von_mises(sigma: np.ndarray) -> np.ndarray:
     return np.sqrt(1.5 * np.einsum("...ij,...ij->...", deviator, deviator))
 
 
-def _point_values(tensors: tuple[np.ndarray, ...], fields: list[str]) -> dict[str, np.ndarray]:
+def _point_values(sim: Simulation, tensors: tuple[np.ndarray, ...], fields: list[str]) -> dict[str, np.ndarray]:
     """Each requested cell field at every integration point, (ne, nq, nt, ...), from the
     (lamina, Cauchy, Green-Lagrange) tensors there."""
     lamina, cauchy, green = tensors
@@ -171,6 +176,12 @@ def _point_values(tensors: tuple[np.ndarray, ...], fields: list[str]) -> dict[st
               "pressure_band": pressure_band(cauchy)}
     if "von_mises" in fields:
         values["von_mises"] = von_mises(cauchy)
+    if {PK2, MATERIAL_STRESS} & set(fields):
+        F, jac = deformation_gradients(sim, list(range(len(sim.model.rule.tz))))
+        frames0 = sim.model.material.axes0
+        values[PK2] = second_piola_in(frames0, F, cauchy)
+        frames = current_material_frames(frames0, F, jac)
+        values[MATERIAL_STRESS] = frames @ cauchy @ np.swapaxes(frames, -1, -2)
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 
@@ -185,15 +196,10 @@ def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
     """Each fibre family's current vector F a0 at every in-plane integration point of the
     ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family: its
     initial unit direction a0 (the law's ``fibres`` in the initial material frame) carried
-    by the deformation gradient F = dx/d(r, s, t) (dX/d(r, s, t))^-1; its length is the
-    fibre's stretch, sqrt(I4)."""
-    model, state, rule = sim.model, sim.state, sim.model.rule
-    nq = len(rule.wq)
-    F = np.empty((model.n_elements, nq, len(layers), 3, 3))
-    for column, k in enumerate(layers):
-        jac = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq],
-                             rule.tz[k])[1]
-        F[:, :, column] = jac @ model.body.jac0_inv[:, :nq, k]
+    by the deformation gradient (:func:`~shellsim.output.derived.deformation_gradients`);
+    its length is the fibre's stretch, sqrt(I4)."""
+    model = sim.model
+    F, _ = deformation_gradients(sim, layers)
     frames = model.material.axes0[:, :, layers]  # rows: material axes 1, 2, 3
     return [np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
             for c, s in LAWS[model.material.law].fibres(model.material.params)]
@@ -259,7 +265,7 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
     cell_data: dict[str, np.ndarray] = {}
     tensors = sim.point_tensors() if set(fields) & {*CELL_FIELDS, PRINCIPAL, VESSEL} else None
     flats = {name: symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
-             for name, values in (_point_values(tensors, fields) if tensors is not None else {}).items()}
+             for name, values in (_point_values(sim, tensors, fields) if tensors is not None else {}).items()}
     for name, flat in flats.items():
         if mesh.solid:
             cell_data[name] = _columns(_on_cells(flat, mesh))

@@ -222,26 +222,42 @@ EXIT_UNSTABLE = 3
 @app.command()
 @reports_errors
 def run(
-    deck: DeckPath,
+    deck: Annotated[Path | None, typer.Argument(help="Scene deck (TOML); none with --resume.", show_default=False)] = None,
     out_dir: Annotated[Path | None, typer.Option("--out", help="Output folder [default: results/DECK-NAME].")] = None,
+    resume: Annotated[Path | None, typer.Option(
+        "--resume", help="Go on from the checkpoint in a run's folder (output.checkpoint_interval), "
+                                           "to its deck's end.")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
     """Run a scene: in time by explicit central differences, or as equilibria by Newton
     load steps (solver.method = "static"). Writes OUT/summary.json,
     OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
-    and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. Exit code 1 when a
-    reference check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM
-    (what was written stays readable; the summary says interrupted)."""
+    and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. With --resume
+    FOLDER, a run that stopped goes on from its last checkpoint there, with the deck it was
+    run with, to the same answer as if it had not stopped. Exit code 1 when a reference
+    check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM (what was
+    written stays readable; the summary says interrupted)."""
     from .compile_watch import watching_compiles
     from .deck import load_deck
+    from .deck.resolved import RESOLVED_NAME, read_resolved
     from .execute import run_scene
+    from .output.checkpoint import read_checkpoint
     from .output.progress import ProgressDisplay
 
-    scene = load_deck(deck)
-    folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
+    if (deck is None) == (resume is None):
+        raise typer.BadParameter("give a deck to run, or --resume and a run's folder to go on with it"
+                                 + (", not both" if deck else ""), param_hint="DECK / --resume")
+    if resume is not None:
+        if out_dir is not None:
+            raise typer.BadParameter("a resumed run goes on in its own folder", param_hint="--out")
+        checkpoint = read_checkpoint(resume)
+        scene, deck, folder = read_resolved(resume), resume / RESOLVED_NAME, resume
+    else:
+        checkpoint, scene = None, load_deck(deck)
+        folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
     with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress, \
             watching_compiles(progress.compiling, progress.compiled):
-        current, result = run_scene(scene, deck, folder, progress, progress.announce)
+        current, result = run_scene(scene, deck, folder, progress, progress.announce, checkpoint)
     message = result["message"]
     if current.status == "interrupted":
         raise KeyboardInterrupt

@@ -61,26 +61,30 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
 
 def solve(run: Run, listener: Listener | None = None) -> Run:
     """Solve ``run`` by its deck's method: statically, explicitly, or explicitly after a
-    static preload."""
+    static preload; a run restored from a checkpoint goes on in time."""
     from .solver.preload import preload_then_integrate
     from .solver.run import integrate
     from .solver.static import solve_static
 
     solver = run.deck.solver
     method = (solve_static if solver.method == "static" else
-              integrate if solver.preload is None else preload_then_integrate)
+              integrate if solver.preload is None or run.stepping is not None else preload_then_integrate)
     return method(run, listener)
 
 
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
-              announce: Callable[[str], None] = _silent) -> tuple[Run, dict]:
+              announce: Callable[[str], None] = _silent, checkpoint: dict | None = None) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
     (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
-    and summary.json whatever the end. Returns (run, summary); ``run.status`` tells how it
-    ended ('completed', 'unstable', 'interrupted', 'output failed', 'refused': too long to
-    run) and the summary's ``message`` why. ``announce`` hears the stages before the first
-    step. Renders are left to the caller."""
+    the checkpoints the deck asks for, and summary.json whatever the end. Going on from a
+    ``checkpoint`` (:func:`shellsim.output.checkpoint.read_checkpoint` of ``folder``, whose
+    deck.toml ``scene`` is), the run starts from it and the files keep what was written
+    up to it. Returns (run, summary); ``run.status`` tells how it ended ('completed',
+    'unstable', 'interrupted', 'output failed', 'refused': too long to run) and the
+    summary's ``message`` why. ``announce`` hears the stages before the first step.
+    Renders are left to the caller."""
     from .deck.resolved import RESOLVED_NAME, resolved_text
+    from .output.checkpoint import Checkpoints, restore
     from .output.folder import write_atomically
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
@@ -89,13 +93,19 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .solver.run import output_times
 
     current = built_run(scene, deck_path.parent, announce)
-    write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+    kept_samples = kept_frames = None
+    if checkpoint is None:
+        write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+    else:
+        restore(current, checkpoint)
+        kept_samples, kept_frames = len(current.times), len(current.frame_times)
     message = None
     with ExitStack() as files:
-        history = files.enter_context(closing(HistoryWriter(folder / "history.csv")))
-        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output)))
+        history = files.enter_context(closing(HistoryWriter(folder / "history.csv", kept_samples)))
+        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
         check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
-        writers = Timed(Listeners(history, frames))
+        interval = scene.output.checkpoint_interval
+        writers = Timed(Listeners(history, frames, *([Checkpoints(folder, interval, current.sim.state.t)] if interval else [])))
         try:
             solve(current, Listeners(writers, progress or Listener()))
         except (NumericalError, SceneTooLarge) as error:

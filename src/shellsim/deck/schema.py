@@ -485,7 +485,9 @@ class Output(Section):
     (pressures follow the stresses' unit unless given; the files keep the deck's units);
     ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop and axial
     stresses in (by default the material's, when they are a tube's or a centreline's);
-    probes (history.csv), a valve's measures and renders."""
+    ``checkpoint_interval`` (explicit runs) writes checkpoint.pkl at the first frame at or
+    after each multiple of it, which ``shellsim run --resume FOLDER`` goes on from, to the
+    same answer; probes (history.csv), a valve's measures and renders."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
@@ -498,6 +500,7 @@ class Output(Section):
     vessel_axes: VesselAxes | None = None
     faces: list[Literal["bottom", "top"]] = []
     display_units: dict[Literal[tuple(UNIT_SIZES)], str] = {}
+    checkpoint_interval: Positive | None = None
     probe: list[Probe] = []
     render: list[Render] = []
     valve: Valve | None = None
@@ -703,6 +706,9 @@ class Deck(Section):
         if not self.material.ANISOTROPIC:
             problems += [f"output.fields: '{name}' is of a fibre-reinforced law's fibres, and material.model = "
                          f"'{self.material.model}' has none" for name in FIBRE_FIELDS if name in self.output.fields]
+        if self.output.checkpoint_interval is not None and self.solver.method == "static":
+            problems.append(f"output.checkpoint_interval = {self.output.checkpoint_interval:g}: checkpoints are of "
+                            "the explicit time loop, and solver.method = 'static' solves in load steps; drop it")
         if self.section.technique != 1:
             problems += [f"output.fields: '{name}' is in the axes of a hyperelastic material (section.technique = 1), "
                          f"and material.model = '{self.material.model}' with section.technique = "

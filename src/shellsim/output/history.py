@@ -23,16 +23,22 @@ def energy_columns(run: Run) -> tuple[str, ...]:
 
 
 class HistoryWriter(Listener):
-    """Appends one CSV row per history sample to ``path``."""
+    """Appends one CSV row per history sample to ``path``; going on from a checkpoint
+    (``kept`` samples), after the header and that many rows of the file there."""
 
-    def __init__(self, path: Path):
+    def __init__(self, path: Path, kept: int | None = None):
         self.path = path
         try:
+            earlier = []
+            if kept:
+                with open(path, newline="", encoding="utf-8") as written:  # its rows' own line ends
+                    earlier = written.readlines()[:kept + 1]
             self._file = open(path, "w", newline="", encoding="utf-8")
+            self._file.writelines(earlier)
         except OSError as error:
             raise OutputError(f"cannot write '{path}': {error.strerror}") from None
         self._writer = csv.writer(self._file)
-        self._header_written = False
+        self._header_written = bool(earlier)
 
     def on_sample(self, run: Run) -> None:
         if not self._header_written:

@@ -29,9 +29,10 @@ SERIES = {"xdmf": XdmfSeries, "vtu": VtuSeries}
 
 
 class FrameWriter(Listener):
-    """Writes every frame of a run to each format the deck's ``[output]`` asks for."""
+    """Writes every frame of a run to each format the deck's ``[output]`` asks for; going
+    on from a checkpoint, after the first ``kept`` frames of each series in ``folder``."""
 
-    def __init__(self, folder: Path, run: Run, output: Output):
+    def __init__(self, folder: Path, run: Run, output: Output, kept: int | None = None):
         self.fields, self.vessel_axes, self.faces = list(output.fields), output.vessel_axes, tuple(output.faces)
         self.part = output_mesh(run.model, output.solid)
         self.copies = mirrors(mirror_planes(run.deck, run.mesh))
@@ -42,10 +43,10 @@ class FrameWriter(Listener):
         self.series, self.cable_series = [], []
         try:
             for kind in dict.fromkeys(output.formats):
-                self.series.append(SERIES[kind](folder, self.mesh, self.encoding))
+                self.series.append(SERIES[kind](folder, self.mesh, self.encoding, kept=kept))
                 if self.cables is not None:
-                    self.cable_series.append(SERIES[kind](folder, self.cables, self.encoding, CABLES))
-        except OSError as error:
+                    self.cable_series.append(SERIES[kind](folder, self.cables, self.encoding, CABLES, kept))
+        except (OSError, ET.ParseError) as error:  # a series to go on with may be damaged
             self.close()
             raise OutputError(f"cannot write the {kind} series in '{folder}': {error.strerror or error}") from None
 

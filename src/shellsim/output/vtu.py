@@ -16,18 +16,25 @@ FRAMES_DIR = "frames"
 class VtuSeries:
     """``<name>.pvd`` + one VTU per frame in ``folder`` (frames in ``frames`` for the
     results, ``<name>_frames`` for another series), on ``mesh`` (its points (P, 3), cells
-    (C, k) and cell type), numbers stored as ``encoding`` says."""
+    (C, k) and cell type), numbers stored as ``encoding`` says; going on from a checkpoint,
+    after the first ``kept`` frames of the series there."""
 
-    def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results"):
+    def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results", kept: int | None = None):
         self.name = name
         self.path = folder / f"{name}.pvd"
         self.frames = folder / (FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}")
-        if self.frames.exists():  # frames of an earlier run would be listed by nobody
-            shutil.rmtree(self.frames)
-        self.frames.mkdir()
         self.mesh = mesh
         self.encoding = encoding
         self.entries: list[tuple[float, str]] = []
+        if kept is not None:
+            listed = [(float(item.get("timestep")), item.get("file")) for item in ET.parse(self.path).getroot().iter("DataSet")]
+            self.entries = listed[:kept]
+            for _, file in listed[kept:]:
+                (folder / file).unlink(missing_ok=True)
+            return
+        if self.frames.exists():  # frames of an earlier run would be listed by nobody
+            shutil.rmtree(self.frames)
+        self.frames.mkdir()
 
     def write(self, t: float, point_data: dict, cell_data: dict) -> None:
         """Add the frame at time ``t``: fields (P,) or (P, k) on the points, (C,) or (C, k)

@@ -29,14 +29,19 @@ ATTRIBUTE_TYPE = {1: "Scalar", 3: "Vector"}
 
 class XdmfSeries:
     """``<name>.xdmf`` + ``<name>.h5`` in ``folder``, on ``mesh`` (its points (P, 3),
-    cells (C, k) and cell type), numbers stored as ``encoding`` says."""
+    cells (C, k) and cell type), numbers stored as ``encoding`` says; going on from a
+    checkpoint, after the first ``kept`` frames of the series there."""
 
-    def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results"):
+    def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results", kept: int | None = None):
         import h5py
 
         self.path = folder / f"{name}.xdmf"
         self.encoding = encoding
         self._h5_name = f"{name}.h5"
+        if kept is not None:
+            self._h5 = h5py.File(folder / self._h5_name, "a")
+            self._go_on_after(kept)
+            return
         self._h5 = h5py.File(folder / self._h5_name, "w")
         topology_type, corners = TOPOLOGY[mesh.cell_type]
         self._topology = ET.Element("Topology", TopologyType=topology_type, NumberOfElements=str(len(mesh.cells)),
@@ -48,6 +53,18 @@ class XdmfSeries:
         self._frames = ET.SubElement(ET.SubElement(self._root, "Domain"), "Grid", Name=name, GridType="Collection",
                                      CollectionType="Temporal")
         self.count = 0
+
+    def _go_on_after(self, kept: int) -> None:
+        """The series as written, its frames after the first ``kept`` dropped."""
+        self._root = ET.parse(self.path).getroot()
+        self._frames = self._root.find("Domain/Grid")
+        frames = self._frames.findall("Grid")
+        for grid in frames[kept:]:
+            self._frames.remove(grid)
+        for index in range(kept, len(frames)):
+            self._h5.pop(f"frames/{index}", None)
+        self._topology, self._geometry = frames[0].find("Topology"), frames[0].find("Geometry")
+        self.count = kept
 
     def _item(self, parent: ET.Element, path: str, values: np.ndarray) -> None:
         """Store ``values`` at ``path`` in the HDF5 file and point ``parent`` at it."""

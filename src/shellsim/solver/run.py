@@ -46,6 +46,16 @@ ENERGY_FLOOR = 1e-12
 #: that waits unloaded moves by round-off alone, with no external work to measure it by.
 ROUND_OFF = 1e-20
 @dataclass
+class Stepping:
+    """When the time loop estimates the critical step next: ``interval`` steps after the
+    last estimate, ``since_update`` of them taken (:class:`.timestep.EstimateSchedule`)."""
+
+    schedule: EstimateSchedule
+    interval: int
+    since_update: int = 0
+
+
+@dataclass
 class Run:
     """A scene being run: the simulation, its time step record and probe histories."""
 
@@ -75,6 +85,7 @@ class Run:
     valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS
     relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
     unloading: object | None = None  # finding an imaged scene's unloaded shape (unloaded.Unloading)
+    stepping: Stepping | None = None  # the time loop's place between step estimates, once it has begun
 
     @property
     def load_time(self) -> float:
@@ -335,16 +346,17 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     solver = run.deck.solver
     sim = run.sim
     with ending(run, listener, "unstable", _breakdown_cause) as start:
-        _update_time_step(run, listener)
-        _scale_masses(run, listener)
-        refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
-        run.startup["first_dt_s"] = time.perf_counter() - start
-        if not run.times:  # else it continues a preload, whose last state is recorded
-            _record(run, listener)
-            _frame(run, listener)
-        schedule = EstimateSchedule(solver.dt_safety_factor, solver.dt_update_every)
-        interval = schedule.after_estimate(sim.state.steps, run.dt_critical)
-        since_update = 0
+        if run.stepping is None:  # else it goes on from a checkpoint
+            _update_time_step(run, listener)
+            _scale_masses(run, listener)
+            refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
+            run.startup["first_dt_s"] = time.perf_counter() - start
+            if not run.times:  # else it continues a preload, whose last state is recorded
+                _record(run, listener)
+                _frame(run, listener)
+            schedule = EstimateSchedule(solver.dt_safety_factor, solver.dt_update_every)
+            run.stepping = Stepping(schedule, schedule.after_estimate(sim.state.steps, run.dt_critical))
+        stepping = run.stepping
         history_interval = solver.end_time / HISTORY_SAMPLES
         landings = output_times(run.deck)
         at_rest = False
@@ -354,12 +366,12 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 step = equal_step(landing - sim.state.t, run.dt)
                 target = min(landing, sim.state.t + max(1, round(history_interval / step)) * step)
                 while sim.state.t < target:
-                    steps = sim.advance(target, step, interval - since_update)
-                    since_update += steps
-                    if since_update >= interval:
+                    steps = sim.advance(target, step, stepping.interval - stepping.since_update)
+                    stepping.since_update += steps
+                    if stepping.since_update >= stepping.interval:
                         _update_time_step(run, listener)
-                        interval = schedule.after_estimate(sim.state.steps, run.dt_critical)
-                        since_update = 0
+                        stepping.interval = stepping.schedule.after_estimate(sim.state.steps, run.dt_critical)
+                        stepping.since_update = 0
                         break  # re-plan the steps with the new dt
                 _record(run, listener)
                 _check_stability(run)

@@ -1,0 +1,148 @@
+"""Restart: an explicit run stopped part way (as Ctrl-C stops it) and resumed from its last
+checkpoint ends with the same history.csv, byte for byte, and the same frames, number for
+number, as the run that never stopped; and what cannot be resumed says why."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.deck import load_deck
+from shellsim.deck.resolved import RESOLVED_NAME, read_resolved
+from shellsim.execute import run_scene
+from shellsim.output.checkpoint import CHECKPOINT_NAME, read_checkpoint
+from shellsim.solver.run import Listener
+
+from .conftest import ROOT, deck_text, problems_of
+
+VERIFICATION = ROOT / "decks" / "verification"
+
+
+class StopAt(Listener):
+    """Stops the run, as Ctrl-C does, at its first frame at or after ``t``."""
+
+    def __init__(self, t: float):
+        self.t = t
+
+    def on_frame(self, run) -> None:
+        if run.sim.state.t >= self.t:
+            raise KeyboardInterrupt
+
+
+def _frames(folder: Path) -> list:
+    reader = meshio.xdmf.TimeSeriesReader(folder / "results.xdmf")
+    reader.read_points_cells()
+    return [reader.read_data(k) for k in range(reader.num_steps)]
+
+
+def _same_frames(a: Path, b: Path) -> None:
+    first, second = _frames(a), _frames(b)
+    assert len(first) == len(second)
+    for (ta, points_a, cells_a), (tb, points_b, cells_b) in zip(first, second):
+        assert ta == tb and points_a.keys() == points_b.keys() and cells_a.keys() == cells_b.keys()
+        for name in points_a:
+            np.testing.assert_array_equal(points_a[name], points_b[name])
+        for name in cells_a:
+            np.testing.assert_array_equal(cells_a[name][0], cells_b[name][0])
+
+
+def _cantilever(tmp_path: Path, name: str, extra: str = "") -> Path:
+    """Test 2's cantilever (or its relaxed variant) with checkpoints every 0.01 s and both
+    series."""
+    text = (VERIFICATION / name).read_text().replace(
+        "[output]\n", f'[output]\ncheckpoint_interval = 0.01\nformats = ["xdmf", "vtu"]\n{extra}', 1)
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def _pressed_plates(tmp_path: Path) -> Path:
+    """Two plates pressed together with friction, explicitly: contact springs and friction
+    anchors carried from step to step."""
+    from shellsim.bench import stacked_plates
+
+    text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3, thickness=0.01).as_posix()}"', '''
+[[boundary]]
+type = "clamped"
+set = "lower"
+[[boundary]]
+type = "fixed"
+set = "upper"
+translations = ["x"]
+[[load]]
+type = "pressure"
+set = "upper"
+value = -1.0
+[[load]]
+type = "body_force"
+set = "upper"
+value = [0.0, 20.0, 0.0]
+[[contact]]
+type = "shells"
+name = "between"
+set = "upper"
+against = "lower"
+friction = 0.3
+[output]
+interval = 0.02
+checkpoint_interval = 0.1
+''').replace("[solver]\nend_time = 1.0", "[solver]\nend_time = 0.4\ndamping = 50.0")
+    path = tmp_path / "plates.toml"
+    path.write_text(text)
+    return path
+
+
+SCENES = {
+    "cantilever": (lambda tmp: _cantilever(tmp, "test02_cantilever_uniform_load_3.toml"), 0.0455),
+    "relaxed": (lambda tmp: _cantilever(tmp, "test02_cantilever_uniform_load_3_relaxed.toml"), 0.0455),
+    "contact_with_friction": (_pressed_plates, 0.25),
+}
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_a_stopped_run_resumed_ends_as_the_run_that_never_stopped(scene, tmp_path):
+    make, stop_at = SCENES[scene]
+    deck_path = make(tmp_path)
+    deck = load_deck(deck_path)
+    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
+    whole.mkdir(), stopped.mkdir()
+    done, _ = run_scene(deck, deck_path, whole)
+    assert done.status == "completed"
+    interrupted, _ = run_scene(deck, deck_path, stopped, StopAt(stop_at))
+    assert interrupted.status == "interrupted" and interrupted.sim.state.t < deck.solver.end_time
+    checkpoint = read_checkpoint(stopped)
+    assert 0.0 < checkpoint["t"] <= interrupted.sim.state.t
+    resumed, summary = run_scene(read_resolved(stopped), stopped / RESOLVED_NAME, stopped, checkpoint=checkpoint)
+    assert resumed.status == "completed" and summary["steps"] == done.sim.state.steps
+    assert (stopped / "history.csv").read_bytes() == (whole / "history.csv").read_bytes()
+    _same_frames(whole, stopped)
+    if "vtu" in deck.output.formats:
+        assert (stopped / "results.pvd").read_bytes() == (whole / "results.pvd").read_bytes()
+        assert sorted(p.name for p in (stopped / "frames").iterdir()) == sorted(p.name for p in (whole / "frames").iterdir())
+
+
+def test_resume_from_the_command_line_and_what_it_refuses(tmp_path):
+    """``shellsim run --resume FOLDER`` goes on in the folder; a folder without a
+    checkpoint, a deck given as well, or a static deck asking for checkpoints are refused
+    with a message naming what to do."""
+    runner = CliRunner()
+    deck_path = _cantilever(tmp_path, "test02_cantilever_uniform_load_3.toml")
+    folder = tmp_path / "run"
+    folder.mkdir()
+    run_scene(load_deck(deck_path), deck_path, folder, StopAt(0.03))
+    result = runner.invoke(app, ["run", "--resume", str(folder), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert '"status": "completed"' in (folder / "summary.json").read_text()
+    (folder / CHECKPOINT_NAME).unlink()
+    result = runner.invoke(app, ["run", "--resume", str(folder), "--quiet"])
+    assert result.exit_code != 0 and "holds no checkpoint to resume from" in " ".join(result.output.split())
+    result = runner.invoke(app, ["run", str(deck_path), "--resume", str(folder)])
+    assert result.exit_code != 0 and "not both" in " ".join(result.output.split())
+    static = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace(
+        "[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0')
+    assert "checkpoints are of the explicit time loop" in problems_of(static + "\n[output]\ncheckpoint_interval = 0.5\n")

@@ -237,7 +237,10 @@ class Imaged(Section):
     back by what it moved, X_{k+1} = X_k - (x_k - x_image) (directors alike, fibre lengths by
     their ratio), until the loaded shape is the image within ``tolerance`` of the model's
     size (1e-4: 6 um on a 60 mm vessel, far below an image's voxels), in at most
-    ``iterations`` solves."""
+    ``iterations`` solves. An artery imaged in situ is also stretched along its axis
+    (tethered, lambda_z about 1.1 to 1.5): a ``prescribed`` boundary that moves an end
+    along the axis by L (1 - 1/lambda_z) over the load to ``at`` (L the imaged length) makes
+    the unloaded shape that much shorter, and the image is reached stretched."""
 
     at: Positive
     tolerance: Positive = 1e-4

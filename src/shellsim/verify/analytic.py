@@ -110,8 +110,11 @@ def _residuals(unknowns, pressure, R_i, R_o, law):
             quad(axial, R_i, R_o, epsrel=1e-12)[0] / (R_o**2 * law.scale)]
 
 
-def tube_inflation(pressures, inner_radius: float, wall_thickness: float, law) -> tuple[np.ndarray, np.ndarray]:
-    """Inner radius r_i and axial stretch lambda_z of the closed-end tube at each pressure.
+def tube_inflation(pressures, inner_radius: float, wall_thickness: float, law,
+                   axial_stretch: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Inner radius r_i and axial stretch lambda_z of the closed-end tube at each pressure,
+    or, given ``axial_stretch``, of the tube whose ends are held at that stretch (an
+    artery tethered in situ: the radial balance alone).
 
     pressures (m,) [stress units], increasing from 0 or above; inner_radius R_i and
     wall_thickness H of the unloaded tube [length]; ``law`` a :class:`Guccione` or
@@ -122,20 +125,25 @@ def tube_inflation(pressures, inner_radius: float, wall_thickness: float, law) -
     pressures = np.asarray(pressures, dtype=float)
     R_i, R_o = inner_radius, inner_radius + wall_thickness
     top = max(float(pressures.max(initial=0.0)), 1e-300)
-    guess = np.array([1.0, 1.0])
+    if axial_stretch is None:
+        residuals, guess = _residuals, np.array([1.0, 1.0])
+    else:  # the radial balance for r_i / R_i; the guess: the wall stretched without pressure
+        def residuals(unknowns, *args):
+            return _residuals([unknowns[0], axial_stretch], *args)[:1]
+        guess = np.array([1.0 / np.sqrt(axial_stretch)])
     done = 0.0
     out_r, out_z = np.empty(len(pressures)), np.empty(len(pressures))
     for index in np.argsort(pressures, kind="stable"):
         target = pressures[index]
         steps = max(1, int(np.ceil((target - done) / (top / 50))))
         for pressure in np.linspace(done, target, steps + 1)[1:]:
-            solution = root(_residuals, guess, args=(pressure, R_i, R_o, law), method="hybr", tol=1e-13)
+            solution = root(residuals, guess, args=(pressure, R_i, R_o, law), method="hybr", tol=1e-13)
             # 'no good progress' at round-off level is convergence: judge by the residual
             if np.abs(solution.fun).max() > 1e-10:
                 raise RuntimeError(f"tube_inflation: no solution at P = {pressure:g}: {solution.message}")
             guess = solution.x
         done = target
-        out_r[index], out_z[index] = guess[0] * R_i, guess[1]
+        out_r[index], out_z[index] = guess[0] * R_i, guess[1] if axial_stretch is None else axial_stretch
     return out_r, out_z
 
 

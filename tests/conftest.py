@@ -99,23 +99,21 @@ def run_deck(deck, base_dir: Path | None = None):
 PLATE_THICKNESS = 0.01
 
 
-def pressed_plates(path: Path, p: float, method: str):
-    """The upper of :func:`shellsim.bench.stacked_plates` (3 x 3 over 4 x 4, thickness PLATE_THICKNESS)
-    pushed onto the clamped lower one by a pressure p, in-plane motion held; solved statically or explicitly with
-    damping until it settles."""
+def pressed_plates_deck(path: Path, p: float, solver: str, held: str = '["x", "y"]', more: str = "") -> str:
+    """A deck of the upper of :func:`shellsim.bench.stacked_plates` (3 x 3 over 4 x 4,
+    thickness PLATE_THICKNESS, written to ``path``) pushed onto the clamped lower one by a
+    pressure p, its translations ``held`` (TOML list), under the ``solver`` table, with
+    ``more`` keys of the contact table and tables after it."""
     from shellsim.bench import stacked_plates
-    from shellsim.deck import parse_deck
 
-    solver = ('[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }' if method == "static"
-              else "[solver]\nend_time = 1.0\ndamping = 50.0")
-    text = deck_text(f'builder = "file"\npath = "{stacked_plates(path, 4, 3, thickness=PLATE_THICKNESS).as_posix()}"', f'''
+    return deck_text(f'builder = "file"\npath = "{stacked_plates(path, 4, 3, thickness=PLATE_THICKNESS).as_posix()}"', f'''
 [[boundary]]
 type = "clamped"
 set = "lower"
 [[boundary]]
 type = "fixed"
 set = "upper"
-translations = ["x", "y"]
+translations = {held}
 [[load]]
 type = "pressure"
 set = "upper"
@@ -125,8 +123,17 @@ type = "shells"
 name = "between"
 set = "upper"
 against = "lower"
-''').replace("[solver]\nend_time = 1.0", solver)
-    return run_deck(parse_deck(text))
+{more}''').replace("[solver]\nend_time = 1.0", solver)
+
+
+def pressed_plates(path: Path, p: float, method: str):
+    """The plates of :func:`pressed_plates_deck` solved statically or explicitly with
+    damping until they settle."""
+    from shellsim.deck import parse_deck
+
+    solver = ('[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }' if method == "static"
+              else "[solver]\nend_time = 1.0\ndamping = 50.0")
+    return run_deck(parse_deck(pressed_plates_deck(path, p, solver)))
 
 
 #: A 2 x 1 plate's geometry and tables for deck_text: clamped along x = 0, a pressure of

@@ -18,7 +18,7 @@ from shellsim.execute import run_scene
 from shellsim.output.checkpoint import CHECKPOINT_NAME, read_checkpoint
 from shellsim.solver.run import Listener
 
-from .conftest import ROOT, deck_text, problems_of
+from .conftest import ROOT, deck_text, pressed_plates_deck, problems_of
 
 VERIFICATION = ROOT / "decks" / "verification"
 
@@ -62,36 +62,10 @@ def _cantilever(tmp_path: Path, name: str, extra: str = "") -> Path:
 
 
 def _pressed_plates(tmp_path: Path) -> Path:
-    """Two plates pressed together with friction, explicitly: contact springs and friction
-    anchors carried from step to step."""
-    from shellsim.bench import stacked_plates
-
-    text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3, thickness=0.01).as_posix()}"', '''
-[[boundary]]
-type = "clamped"
-set = "lower"
-[[boundary]]
-type = "fixed"
-set = "upper"
-translations = ["x"]
-[[load]]
-type = "pressure"
-set = "upper"
-value = -1.0
-[[load]]
-type = "body_force"
-set = "upper"
-value = [0.0, 20.0, 0.0]
-[[contact]]
-type = "shells"
-name = "between"
-set = "upper"
-against = "lower"
-friction = 0.3
-[output]
-interval = 0.02
-checkpoint_interval = 0.1
-''').replace("[solver]\nend_time = 1.0", "[solver]\nend_time = 0.4\ndamping = 50.0")
+    """Two plates pressed together and pushed along y against friction, explicitly."""
+    text = pressed_plates_deck(tmp_path / "plates.vtu", 1.0, "[solver]\nend_time = 0.4\ndamping = 50.0", '["x"]',
+                               "friction = 0.3\n[[load]]\ntype = \"body_force\"\nset = \"upper\"\n"
+                               "value = [0.0, 20.0, 0.0]\n[output]\ninterval = 0.02\ncheckpoint_interval = 0.1\n")
     path = tmp_path / "plates.toml"
     path.write_text(text)
     return path

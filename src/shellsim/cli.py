@@ -225,8 +225,8 @@ def run(
     deck: Annotated[Path | None, typer.Argument(help="Scene deck (TOML); none with --resume.", show_default=False)] = None,
     out_dir: Annotated[Path | None, typer.Option("--out", help="Output folder [default: results/DECK-NAME].")] = None,
     resume: Annotated[Path | None, typer.Option(
-        "--resume", help="Go on from the checkpoint in a run's folder (output.checkpoint_interval), "
-                                           "to its deck's end.")] = None,
+        "--resume", help="Go on from the checkpoint in a run's folder (output.checkpoint_interval), to its deck's "
+                         "end.")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
     """Run a scene: in time by explicit central differences, or as equilibria by Newton

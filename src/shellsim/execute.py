@@ -105,7 +105,8 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
         frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
         check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
         interval = scene.output.checkpoint_interval
-        writers = Timed(Listeners(history, frames, *([Checkpoints(folder, interval, current.sim.state.t)] if interval else [])))
+        checkpoints = [Checkpoints(folder, interval, current.sim.state.t)] if interval else []
+        writers = Timed(Listeners(history, frames, *checkpoints))
         try:
             solve(current, Listeners(writers, progress or Listener()))
         except (NumericalError, SceneTooLarge) as error:

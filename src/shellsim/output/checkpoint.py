@@ -4,7 +4,7 @@ At output frames ``output.checkpoint_interval`` apart, everything the time loop 
 from one step to the next is written to ``checkpoint.pkl`` in the run's folder (replacing
 the last one atomically): the simulation's arrays, the loop's scratch that carries over
 (the incremental formulation's increments, kinetic damping's watch), every array of the
-loads (contact springs, friction anchors), the critical-step estimator's start vector and
+loads (whatever a load kind keeps between steps), the critical-step estimator's start vector and
 random state, when the next estimate is due, and the run's record (history, energies,
 time steps, frames written). Restored into a run built afresh from the folder's resolved
 deck, the run goes on as it would have: the explicit path is deterministic, so its history

@@ -17,7 +17,7 @@ from ..solver.run import Listener, Run
 from .encoding import Encoding
 from .fields import cable_fields, cable_mesh, frame_fields, output_mesh
 from .mirror import mirror_planes, mirrored_mesh, mirrored_values, mirrors
-from .vtu import VtuSeries
+from .vtu import VtuSeries, pvd_entries
 from .xdmf import XdmfSeries
 
 XDMF_NAME, PVD_NAME = "results.xdmf", "results.pvd"
@@ -109,8 +109,7 @@ class StoredSeries:
             self.times = [float(t.get("Value")) for t in ET.parse(xdmf).getroot().iter("Time")]
         elif pvd.exists():
             self._reader = None
-            index = ET.parse(pvd).getroot().iter("DataSet")
-            self._files = [(float(item.get("timestep")), item.get("file")) for item in index]
+            self._files = pvd_entries(pvd)
             self.times = [t for t, _ in self._files]
             first = meshio.read(folder / self._files[0][1]) if self._files else None
             points, cells = (first.points, first.cells) if first else (np.zeros((0, 3)), [])

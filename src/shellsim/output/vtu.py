@@ -13,6 +13,11 @@ from .folder import write_atomically
 FRAMES_DIR = "frames"
 
 
+def pvd_entries(path: Path) -> list[tuple[float, str]]:
+    """(time, file) of each frame a ``.pvd`` index lists, in its order."""
+    return [(float(item.get("timestep")), item.get("file")) for item in ET.parse(path).getroot().iter("DataSet")]
+
+
 class VtuSeries:
     """``<name>.pvd`` + one VTU per frame in ``folder`` (frames in ``frames`` for the
     results, ``<name>_frames`` for another series), on ``mesh`` (its points (P, 3), cells
@@ -27,7 +32,7 @@ class VtuSeries:
         self.encoding = encoding
         self.entries: list[tuple[float, str]] = []
         if kept is not None:
-            listed = [(float(item.get("timestep")), item.get("file")) for item in ET.parse(self.path).getroot().iter("DataSet")]
+            listed = pvd_entries(self.path)
             self.entries = listed[:kept]
             for _, file in listed[kept:]:
                 (folder / file).unlink(missing_ok=True)

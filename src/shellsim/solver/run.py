@@ -45,6 +45,8 @@ ENERGY_FLOOR = 1e-12
 #: square of its size over the critical step (more than a unit strain's energy): a scene
 #: that waits unloaded moves by round-off alone, with no external work to measure it by.
 ROUND_OFF = 1e-20
+
+
 @dataclass
 class Stepping:
     """When the time loop estimates the critical step next: ``interval`` steps after the

@@ -139,18 +139,19 @@ class NewtonSolver:
             if iteration == 0:
                 if not np.any(known) and norm <= settings.force_tolerance * scale:
                     return 0, 0, norm / max(scale, 1e-300)  # nothing changed (a held load)
-                runaway = RUNAWAY * scale if scale > 0.0 and not np.any(known) else np.inf
+                start_scale = scale if scale > 0.0 and not np.any(known) else np.inf  # RUNAWAY's measure
             else:
                 # the energy of the next correction, with the last factorisation
                 energy = abs(float(self.tangent[1].solve(residual) @ residual))
                 stalled = fresh and norm > SLOW * previous
-                if scale <= runaway and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
+                ran_away = scale > RUNAWAY * start_scale
+                if not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
                     self.held_apart(t)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
-                                   "of the force scale" + (f", and forces {scale / runaway * RUNAWAY:.3g} times "
-                                                           "those the step started from" if scale > runaway else ""))
+                                   "of the force scale" + (f", and forces {scale / start_scale:.3g} times those the "
+                                                           "step started from" if ran_away else ""))
             fresh = self.tangent is None or settings.newton == "full" or norm > SLOW * previous
             if fresh:
                 if before is not None and norm > previous:  # an old tangent led away: undo its correction

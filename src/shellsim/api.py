@@ -41,16 +41,17 @@ def run(deck: Deck | str | Path | dict, out: str | Path, base_dir: str | Path | 
     its :class:`Results`; a run that ends short (unstable, not converged, interrupted)
     returns too, its ``status`` and ``summary["message"]`` telling why."""
     from .execute import run_scene
-    from .output.folder import output_folder
+    from .output.folder import claimed, output_folder
     from .output.render import deck_renders
 
     is_file = isinstance(deck, (str, Path))
     scene = deck if isinstance(deck, Deck) else load(deck, base_dir)
     deck_path = Path(deck) if is_file else Path(base_dir or Path.cwd()) / "deck.toml"
     folder = output_folder(Path(out))
-    current, _ = run_scene(scene, deck_path, folder)
-    if renders and current.status == "completed":
-        deck_renders(scene, folder)
+    with claimed(folder):  # the renders too
+        current, _ = run_scene(scene, deck_path, folder)
+        if renders and current.status == "completed":
+            deck_renders(scene, folder)
     return Results(folder)
 
 

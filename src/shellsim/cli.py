@@ -242,6 +242,7 @@ def run(
     from .deck.resolved import RESOLVED_NAME, read_resolved
     from .execute import run_scene
     from .output.checkpoint import read_checkpoint
+    from .output.folder import claimed
     from .output.progress import ProgressDisplay
 
     if (deck is None) == (resume is None):
@@ -255,22 +256,23 @@ def run(
     else:
         checkpoint, scene = None, load_deck(deck)
         folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
-    with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress, \
-            watching_compiles(progress.compiling, progress.compiled):
-        current, result = run_scene(scene, deck, folder, progress, progress.announce, checkpoint)
-    message = result["message"]
-    if current.status == "interrupted":
-        raise KeyboardInterrupt
-    if current.status == "refused":
-        raise SceneTooLarge(message)
-    if current.status == "output failed":
-        raise OutputError(message)
-    if current.status == "completed":
-        from .output.render import deck_renders
+    with claimed(folder):  # the renders too
+        with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress, \
+                watching_compiles(progress.compiling, progress.compiled):
+            current, result = run_scene(scene, deck, folder, progress, progress.announce, checkpoint)
+        message = result["message"]
+        if current.status == "interrupted":
+            raise KeyboardInterrupt
+        if current.status == "refused":
+            raise SceneTooLarge(message)
+        if current.status == "output failed":
+            raise OutputError(message)
+        if current.status == "completed":
+            from .output.render import deck_renders
 
-        written = deck_renders(scene, folder)
-        if not quiet:
-            _announce(written)
+            written = deck_renders(scene, folder)
+            if not quiet:
+                _announce(written)
     if not quiet:
         out.print(_run_report(result, folder))
     if current.status in ("unstable", "not converged"):

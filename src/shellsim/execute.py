@@ -72,11 +72,25 @@ def solve(run: Run, listener: Listener | None = None) -> Run:
     return method(run, listener)
 
 
+def _run_files() -> tuple[str, ...]:
+    """The files and folders a run writes into its folder, renders included."""
+    from .deck.resolved import RESOLVED_NAME
+    from .output.checkpoint import CHECKPOINT_NAME
+    from .output.render import RENDERS_DIR
+    from .output.series import CABLES
+    from .output.vtu import FRAMES_DIR
+
+    series = tuple(f"{name}.{kind}" for name in ("results", CABLES) for kind in ("xdmf", "h5", "pvd"))
+    return (RESOLVED_NAME, "history.csv", "summary.json", CHECKPOINT_NAME, RENDERS_DIR, FRAMES_DIR,
+            f"{CABLES}_{FRAMES_DIR}", *series)
+
+
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
               announce: Callable[[str], None] = _silent, checkpoint: dict | None = None) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
     (already checked by :func:`output_folder`): deck.toml, history.csv, the frame series,
-    the checkpoints the deck asks for, and summary.json whatever the end. Going on from a
+    the checkpoints the deck asks for, and summary.json whatever the end, holding the
+    folder against other runs and first clearing an earlier run's files. Going on from a
     ``checkpoint`` (:func:`shellsim.output.checkpoint.read_checkpoint` of ``folder``, whose
     deck.toml ``scene`` is), the run starts from it and the files keep what was written
     up to it. Returns (run, summary); ``run.status`` tells how it ended ('completed',
@@ -85,38 +99,40 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     Renders are left to the caller."""
     from .deck.resolved import RESOLVED_NAME, resolved_text
     from .output.checkpoint import Checkpoints, restore
-    from .output.folder import write_atomically
+    from .output.folder import claimed, clear_earlier_run, write_atomically
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
     from .output.summary import summary, write_json
     from .plan import plan
     from .solver.run import output_times
 
-    current = built_run(scene, deck_path.parent, announce)
-    kept_samples = kept_frames = None
-    if checkpoint is None:
-        write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
-    else:
-        restore(current, checkpoint)
-        kept_samples, kept_frames = len(current.times), len(current.frame_times)
-    message = None
-    with ExitStack() as files:
-        history = files.enter_context(closing(HistoryWriter(folder / "history.csv", kept_samples)))
-        frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
-        check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
-        interval = scene.output.checkpoint_interval
-        checkpoints = [Checkpoints(folder, interval, current.sim.state.t)] if interval else []
-        writers = Timed(Listeners(history, frames, *checkpoints))
-        try:
-            solve(current, Listeners(writers, progress or Listener()))
-        except (NumericalError, SceneTooLarge) as error:
-            message = str(error)
-        except KeyboardInterrupt as stop:
-            message = str(stop) or "interrupted by the user"
-        except OutputError as error:
-            current.status, message = "output failed", str(error)
-        finally:
-            files.close()
-            result = summary(current, deck_path, plan(scene), message, writers.seconds)
-            write_json(result, folder / "summary.json")
+    with claimed(folder):  # before anything is written; another run's files stay as they are
+        current = built_run(scene, deck_path.parent, announce)
+        kept_samples = kept_frames = None
+        if checkpoint is None:
+            clear_earlier_run(folder, _run_files())
+            write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+        else:
+            restore(current, checkpoint)
+            kept_samples, kept_frames = len(current.times), len(current.frame_times)
+        message = None
+        with ExitStack() as files:
+            history = files.enter_context(closing(HistoryWriter(folder / "history.csv", kept_samples)))
+            frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
+            check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
+            interval = scene.output.checkpoint_interval
+            checkpoints = [Checkpoints(folder, interval, current.sim.state.t)] if interval else []
+            writers = Timed(Listeners(history, frames, *checkpoints))
+            try:
+                solve(current, Listeners(writers, progress or Listener()))
+            except (NumericalError, SceneTooLarge) as error:
+                message = str(error)
+            except KeyboardInterrupt as stop:
+                message = str(stop) or "interrupted by the user"
+            except OutputError as error:
+                current.status, message = "output failed", str(error)
+            finally:
+                files.close()
+                result = summary(current, deck_path, plan(scene), message, writers.seconds)
+                write_json(result, folder / "summary.json")
     return current, result

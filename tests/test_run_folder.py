@@ -1,0 +1,83 @@
+"""A run's folder is never corrupted: a run holds it, so a second run into it is refused
+before it writes anything, and a new run first clears what an earlier run left there, so
+nothing of the earlier run is taken for the new run's."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from shellsim.cli import app
+from shellsim.output.folder import LOCK_NAME
+
+from .conftest import CLAMPED_PLATE, deck_text
+
+runner = CliRunner()
+#: A clamped plate under a pressure, a few frames long.
+PLATE = deck_text(*CLAMPED_PLATE).replace("end_time = 1.0", "end_time = 0.05")
+
+
+@contextmanager
+def held_by_another_process(folder: Path):
+    """``folder`` held, as a running run holds it, by a second Python process until the
+    block ends."""
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import sys; from pathlib import Path; from shellsim.output.folder import claimed\n"
+                               f"with claimed(Path({str(folder)!r})):\n    print('held', flush=True)\n"
+                               "    sys.stdin.read()"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "held"
+        yield
+    finally:
+        holder.communicate("")
+
+
+def test_a_second_run_into_a_folder_in_use_is_refused_and_touches_nothing(tmp_path):
+    """While another process holds the folder (as a first run does), ``shellsim run`` into
+    it exits with a message naming the holder, and every file there keeps its bytes; once
+    the folder is free the same command runs."""
+    deck = tmp_path / "plate.toml"
+    deck.write_text(PLATE)
+    folder = tmp_path / "run"
+    folder.mkdir()
+    earlier = {"deck.toml": b"# the first run's deck\n", "history.csv": b"time,dt\n0,1e-3\n",
+               "results.xdmf": b"<Xdmf/>"}
+    for name, data in earlier.items():
+        (folder / name).write_bytes(data)
+    with held_by_another_process(folder):
+        result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
+        message = " ".join(result.output.split())
+        assert result.exit_code != 0 and "is in use by another run (pid" in message
+        assert {path.name: path.read_bytes() for path in folder.iterdir() if path.name in earlier} == earlier
+        assert not (folder / "summary.json").exists()
+    result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert (folder / LOCK_NAME).exists()
+
+
+def test_a_new_run_clears_what_an_earlier_run_left(tmp_path):
+    """An earlier run's summary, checkpoint, VTU frames and cable series are gone once a
+    new run (writing XDMF only, no cables, no checkpoints) has started; the summary there is
+    the new run's."""
+    deck = tmp_path / "plate.toml"
+    deck.write_text(PLATE)
+    folder = tmp_path / "run"
+    (folder / "frames").mkdir(parents=True)
+    (folder / "frames" / "results_0007.vtu").write_text("<VTKFile/>")
+    for name in ("results.pvd", "cables.xdmf", "cables.h5", "checkpoint.pkl"):
+        (folder / name).write_text("earlier")
+    (folder / "summary.json").write_text(json.dumps({"status": "completed", "title": "an earlier scene"}))
+    (folder / "notes.txt").write_text("the user's own")
+    result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
+    assert result.exit_code == 0, result.output
+    left = {path.name for path in folder.iterdir()}
+    assert not left & {"frames", "results.pvd", "cables.xdmf", "cables.h5", "checkpoint.pkl"}
+    assert json.loads((folder / "summary.json").read_text())["title"] == "test scene"
+    assert (folder / "notes.txt").read_text() == "the user's own"
+

@@ -1,6 +1,7 @@
 """A run's folder is never corrupted: a run holds it, so a second run into it is refused
-before it writes anything, and a new run first clears what an earlier run left there, so
-nothing of the earlier run is taken for the new run's."""
+before it writes anything; a new run first clears what an earlier run left there, so
+nothing of the earlier run is taken for the new run's; a disk that fills stops the run
+cleanly, with its summary and its frames so far."""
 
 from __future__ import annotations
 
@@ -10,12 +11,13 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from shellsim.cli import app
 from shellsim.output.folder import LOCK_NAME
 
-from .conftest import CLAMPED_PLATE, deck_text
+from .conftest import CLAMPED_PLATE, ROOT, deck_text
 
 runner = CliRunner()
 #: A clamped plate under a pressure, a few frames long.
@@ -81,3 +83,37 @@ def test_a_new_run_clears_what_an_earlier_run_left(tmp_path):
     assert json.loads((folder / "summary.json").read_text())["title"] == "test scene"
     assert (folder / "notes.txt").read_text() == "the user's own"
 
+
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 3 MB file system (a tmpfs; mounting one needs root, so the test is skipped
+    without)."""
+    mount = tmp_path / "small"
+    mount.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3M", "tmpfs", str(mount)], capture_output=True).returncode:
+        pytest.skip("mounting a small tmpfs needs root")
+    yield mount
+    subprocess.run(["umount", "-l", str(mount)], check=True)
+
+
+def test_a_disk_that_fills_mid_run_stops_it_cleanly(small_disk):
+    """Test 2's cantilever writing a frame every 0.5 ms into 3 MB: the run stops with exit
+    code 2 and an error naming the file and 'No space left', its summary says 'output
+    failed', no partial file is left, and every frame written before stays readable (with
+    a checkpoint to go on from once there is room)."""
+    import meshio
+
+    deck = small_disk.parent / "cantilever.toml"
+    deck.write_text((ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3.toml").read_text()
+                    .replace("[output]\ninterval = 0.001", "[output]\ninterval = 0.0005\ncheckpoint_interval = 0.01"))
+    folder = small_disk / "run"
+    result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
+    assert result.exit_code == 2 and "No space left on device" in " ".join(result.output.split())
+    summary = json.loads((folder / "summary.json").read_text())
+    assert summary["status"] == "output failed" and "No space left on device" in summary["message"]
+    assert not list(folder.glob("*.partial"))
+    reader = meshio.xdmf.TimeSeriesReader(folder / "results.xdmf")
+    reader.read_points_cells()
+    assert 10 < reader.num_steps == summary["frames"] < 241
+    reader.read_data(reader.num_steps - 1)
+    assert (folder / "checkpoint.pkl").exists()

@@ -33,6 +33,7 @@ def write_atomically(path: Path, data: str | bytes) -> None:
         partial.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
         os.replace(partial, path)
     except OSError as error:
+        partial.unlink(missing_ok=True)  # on a full disk, the room it took is the summary's
         raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
 
 

@@ -220,3 +220,37 @@ def test_a_truncated_mesh_is_a_failed_row_and_a_dying_worker_is_named(tmp_path):
     assert before == after
     assert rows[1]["status"] == "failed" and "the worker process running this job" in rows[1]["message"]
     assert "variant 'cut'" in rows[1]["message"]
+
+
+def test_every_job_has_its_own_folder_and_row(tmp_path):
+    """Two decks of one file name in different folders, and labels that slug alike ("a b",
+    "a-b"): four jobs, four row keys (the shared name becomes each deck's path), four
+    folders (the alike slugs each with a short hash of their own name), the same whatever
+    the order; one label given twice for one family is refused."""
+    from shellsim.errors import StudyError
+    from shellsim.study.jobs import study_jobs
+    from shellsim.study.schema import load_study
+
+    for sub in ("left", "right"):
+        (tmp_path / sub).mkdir()
+        (tmp_path / sub / "plate.toml").write_text(BASE + '[geometry]\nbuilder = "rectangle"\nlength = 1.0\nwidth = 1.0\n')
+    variants = '[[deck.variant]]\nlabel = "a b"\n\n[[deck.variant]]\nlabel = "a-b"\n'
+    study = tmp_path / "study.toml"
+    study.write_text(f'[meta]\ntitle = "alike"\n\n[[deck]]\npath = "left/plate.toml"\n\n{variants}\n'
+                     f'[[deck]]\npath = "right/plate.toml"\n\n{variants}')
+    jobs = study_jobs(load_study(study), study, tmp_path / "out")
+    assert len({job.key for job in jobs}) == len({job.folder for job in jobs}) == 4
+    assert {job.family for job in jobs} == {"left/plate", "right/plate"}
+    reversed_study = tmp_path / "reversed.toml"
+    reversed_study.write_text(f'[meta]\ntitle = "alike"\n\n[[deck]]\npath = "right/plate.toml"\n\n'
+                              f'{variants.replace("a b", "x").replace("a-b", "a b")}\n[[deck]]\npath = "left/plate.toml"\n\n'
+                              f'{variants}')
+    again = {(job.family, job.label): job.folder for job in study_jobs(load_study(reversed_study), reversed_study,
+                                                                        tmp_path / "out")}
+    assert again[("left/plate", "a b")] == next(job.folder for job in jobs if job.key == "left/plate / a b")
+    twice = tmp_path / "twice.toml"
+    twice.write_text('[meta]\ntitle = "twice"\n\n[[deck]]\npath = "left/plate.toml"\nfamily = "plates"\n\n'
+                     '[[deck.variant]]\nlabel = "coarse"\n\n[[deck]]\npath = "right/plate.toml"\nfamily = "plates"\n\n'
+                     '[[deck.variant]]\nlabel = "coarse"\n')
+    with pytest.raises(StudyError, match="variant 'coarse' of family 'plates' is given twice"):
+        study_jobs(load_study(twice), twice, tmp_path / "out")

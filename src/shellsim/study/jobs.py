@@ -3,13 +3,15 @@ returning one small row for the report (the run's files stay in its own folder).
 
 from __future__ import annotations
 
+import hashlib
 import re
 import tomllib
-from dataclasses import dataclass
+from collections import Counter
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..deck import Deck
-from ..errors import DeckError
+from ..errors import DeckError, StudyError
 from .schema import Study
 
 
@@ -38,16 +40,48 @@ def _slug(text: str) -> str:
 
 
 def study_jobs(study: Study, study_path: Path, out_dir: Path) -> list[Job]:
-    """Every (deck, variant) of ``study`` as a job writing under ``out_dir/runs``."""
+    """Every (deck, variant) of ``study`` as a job writing under ``out_dir/runs``, each in
+    a folder of its own and with a row key (family, label) of its own: a deck's family is
+    its file name, or its path from the study where decks in other folders share the name;
+    names that slug alike ("a b", "a-b") get a short stable hash of themselves. Raises
+    StudyError for two variants of one family with the same label."""
+    decks = [(entry, (study_path.parent / entry.path).resolve()) for entry in study.deck]
+    paths_by_stem: dict[str, set[Path]] = {}
+    for entry, deck in decks:
+        if not entry.family:
+            paths_by_stem.setdefault(deck.stem, set()).add(deck)
     jobs = []
-    for entry in study.deck:
-        deck = (study_path.parent / entry.path).resolve()
-        family = entry.family or deck.stem
+    for entry, deck in decks:
+        shared = len(paths_by_stem.get(deck.stem, ())) > 1
+        family = entry.family or (_relative(deck, study_path.parent) if shared else deck.stem)
         for variant in entry.variant:
-            folder = out_dir / "runs" / _slug(family) / _slug(variant.label)
-            jobs.append(Job(family, variant.label, deck, dict(variant.set), folder, variant.expect,
+            jobs.append(Job(family, variant.label, deck, dict(variant.set), Path(), variant.expect,
                             study.meta.balance_within_percent, entry.dt_falls_by))
-    return jobs
+    twice = [key for key, count in Counter((job.family, job.label) for job in jobs).items() if count > 1]
+    if twice:
+        raise StudyError(f"{study_path}: variant '{twice[0][1]}' of family '{twice[0][0]}' is given twice; its "
+                         "rows and runs would overwrite each other: give each a label of its own")
+    families = _folder_names({job.family for job in jobs})
+    labels = {family: _folder_names({job.label for job in jobs if job.family == family}) for family in families}
+    return [replace(job, folder=out_dir / "runs" / families[job.family] / labels[job.family][job.label]) for job in jobs]
+
+
+def _relative(deck: Path, base: Path) -> str:
+    """``deck``'s path from ``base`` without its suffix (absolute where it is not under it)."""
+    try:
+        return deck.relative_to(base.resolve()).with_suffix("").as_posix()
+    except ValueError:
+        return deck.with_suffix("").as_posix()
+
+
+def _folder_names(names: set[str]) -> dict[str, str]:
+    """A folder name for each of ``names``: its slug, and where another name slugs alike,
+    a short hash of the name itself after it (the same whatever the order)."""
+    by_slug: dict[str, set[str]] = {}
+    for name in names:
+        by_slug.setdefault(_slug(name), set()).add(name)
+    return {name: slug if len(alike) == 1 else f"{slug}-{hashlib.sha1(name.encode()).hexdigest()[:6]}"
+            for slug, alike in by_slug.items() for name in alike}
 
 
 def apply_overrides(data: dict, overrides: dict, name: str) -> dict:

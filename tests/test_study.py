@@ -254,3 +254,25 @@ def test_every_job_has_its_own_folder_and_row(tmp_path):
                      '[[deck.variant]]\nlabel = "coarse"\n')
     with pytest.raises(StudyError, match="variant 'coarse' of family 'plates' is given twice"):
         study_jobs(load_study(twice), twice, tmp_path / "out")
+
+
+def test_an_interrupted_study_says_so_in_its_report(tmp_path, monkeypatch):
+    """Ctrl-C after the first of the quick study's four jobs: report.md says three did not
+    finish, with the one row there is, and the command ends as interrupted (exit code 130)."""
+    from contextlib import nullcontext
+
+    from shellsim.study import executor
+    from shellsim.study.jobs import failed_row
+
+    def one_then_ctrl_c(jobs, client, on_row, threads=None):
+        on_row(failed_row(jobs[0], RuntimeError("stand-in for a finished job")))
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(executor, "open_client", lambda *args: nullcontext())
+    monkeypatch.setattr(executor, "prepare_workers", lambda *args, **kwargs: None)
+    monkeypatch.setattr(executor, "run_jobs", one_then_ctrl_c)
+    result = runner.invoke(app, ["report", str(QUICK), "--out", str(tmp_path)])
+    assert result.exit_code == 130, result.output
+    report = (tmp_path / "report.md").read_text()
+    assert "*Interrupted: 3 job(s) did not finish and have no row.*" in report and "still running" not in report
+    assert len(_rows(tmp_path)) == 1

@@ -428,7 +428,12 @@ def report(
                 out.print(f"{row['family']} / {row['variant']}: {row['status']}, error {error}", highlight=False)
 
             # a local cluster has one worker process per usable CPU: one kernel thread per job
-            run_jobs(jobs, client, on_row, threads=1 if scheduler is None else None)
+            try:
+                run_jobs(jobs, client, on_row, threads=1 if scheduler is None else None)
+            except KeyboardInterrupt:  # the report says the study did not finish
+                write_report(folder, plan_.meta.title, list(rows_in_order(jobs, rows)), len(jobs) - len(rows),
+                             external, interrupted=True)
+                raise
     written = [folder / name for name in ("report.md", "report.csv", "error_vs_time.png")]
     if embed_in is not None:
         embed(embed_in, study.stem, list(rows_in_order(jobs, rows)))

@@ -58,14 +58,16 @@ def table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def markdown(title: str, rows: list[dict], pending: int) -> str:
-    """report.md: the title, what the columns mean, how many jobs are still running, the table."""
+def markdown(title: str, rows: list[dict], pending: int, interrupted: bool = False) -> str:
+    """report.md: the title, what the columns mean, how many jobs are still running (or,
+    the study ``interrupted``, did not finish), the table."""
     lines = [f"# {title}", "", "Error: the largest relative error over the deck's references (closed-form or "
              "literature values cited in each deck); a check with an absolute tolerance counts its error against "
              "the largest value checked on its probe. Balance: the energy balance error, percent of the largest "
              "energy. Wall time: the whole run, one process per job.", ""]
     if pending:
-        lines += [f"*{pending} job(s) still running.*", ""]
+        lines += [f"*Interrupted: {pending} job(s) did not finish and have no row.*" if interrupted else
+                  f"*{pending} job(s) still running.*", ""]
     return "\n".join(lines) + "\n" + table(rows)
 
 
@@ -147,8 +149,10 @@ def error_vs_time_png(title: str, rows: list[dict], external: list[dict]) -> byt
     return buffer.getvalue()
 
 
-def write_report(out_dir: Path, title: str, rows: list[dict], pending: int, external: list[dict]) -> None:
-    """report.md, report.csv and error_vs_time.png in ``out_dir`` for the rows so far."""
-    write_atomically(out_dir / "report.md", markdown(title, rows, pending))
+def write_report(out_dir: Path, title: str, rows: list[dict], pending: int, external: list[dict],
+                 interrupted: bool = False) -> None:
+    """report.md, report.csv and error_vs_time.png in ``out_dir`` for the rows so far
+    (``pending`` jobs without one; see :func:`markdown`)."""
+    write_atomically(out_dir / "report.md", markdown(title, rows, pending, interrupted))
     write_atomically(out_dir / "report.csv", csv_text(rows))
     write_atomically(out_dir / "error_vs_time.png", error_vs_time_png(title, rows, external))

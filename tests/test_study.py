@@ -276,3 +276,41 @@ def test_an_interrupted_study_says_so_in_its_report(tmp_path, monkeypatch):
     report = (tmp_path / "report.md").read_text()
     assert "*Interrupted: 3 job(s) did not finish and have no row.*" in report and "still running" not in report
     assert len(_rows(tmp_path)) == 1
+
+
+@pytest.mark.parametrize("stranger", ["silent", "talking"])
+def test_a_port_that_answers_but_is_no_dask_scheduler_is_named(stranger, tmp_path):
+    """A TCP port that takes the connection and says nothing, or says something else (an
+    HTTP reply): the study ends with a message naming the address (dask's Client waited
+    for ever on the first and raised a MemoryError on the second)."""
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        while True:
+            try:
+                connection, _ = server.accept()
+            except OSError:
+                return
+            held.append(connection)
+            if stranger == "talking":
+                connection.sendall(b"HTTP/1.0 200 OK\r\n\r\nhello")
+
+    threading.Thread(target=serve, daemon=True).start()
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    outcome = []
+    command = threading.Thread(target=lambda: outcome.append(runner.invoke(
+        app, ["report", str(QUICK), "--out", str(tmp_path), "--scheduler", address, "--connect-timeout", "2"])),
+        daemon=True)
+    command.start()
+    command.join(120.0)  # it used to wait for ever
+    server.close()
+    assert outcome, "the study still waits on a port that is not a dask scheduler"
+    result = outcome[0]
+    assert result.exit_code == 2 and "Traceback" not in result.output
+    assert f"'{address}' took the connection but answered" in " ".join(result.output.split())

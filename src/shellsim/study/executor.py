@@ -86,10 +86,44 @@ def prepare_workers(client, local: bool) -> None:
 CONNECT_TIMEOUT = 5.0
 
 
+def _ask_identity(address: str, timeout: float) -> None:
+    """Ask what listens at ``address``, waiting ``timeout`` seconds for the connection and
+    twice that for the answer; raises StudyError unless a dask scheduler answers (a port that
+    takes the connection but says nothing, or something else, kept dask's Client waiting
+    for ever or ended in its MemoryError). OSError when nothing can be reached there."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def identity():
+        # OSError within ``timeout`` when nothing takes the connection; a port that takes it
+        # and stays silent holds connect's own handshake, which the outer wait ends
+        comm = await connect(address, timeout=timeout)
+        try:
+            await comm.write({"op": "identity"})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        answer = asyncio.run(asyncio.wait_for(identity(), 2.0 * timeout))
+    except TimeoutError:  # the connection taken, no word back (an OSError too, so first)
+        answer = None
+    except (OSError, ValueError):
+        raise
+    except Exception as error:  # what a stranger's bytes make of dask's framing
+        answer = f"bytes dask cannot read ({type(error).__name__}: {str(error)[:80]})"
+    if not (isinstance(answer, dict) and answer.get("type") == "Scheduler"):
+        said = (answer if isinstance(answer, str) else "nothing" if answer is None else
+                f"as a dask {answer.get('type', 'something')}")
+        raise StudyError(f"'{address}' took the connection but answered {said} within {2 * timeout:g} s, not as a "
+                         "dask scheduler; give the address a dask scheduler prints (tcp://HOST:8786 by default)")
+
+
 def open_client(scheduler: str | None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
     """A dask client on ``scheduler`` (tcp://host:port), or on a new local cluster of
     ``workers`` single-threaded processes (default: one per CPU this process may use). Raises StudyError when
-    the scheduler does not answer within ``timeout`` seconds.
+    the scheduler does not answer within ``timeout`` seconds, or something else answers.
 
     On the local cluster a job whose worker dies is not given to another worker (dask's
     default tries three more, so one crashing job took four workers down): it becomes a
@@ -99,8 +133,9 @@ def open_client(scheduler: str | None, workers: int | None = None, timeout: floa
 
     if scheduler:
         try:
+            _ask_identity(scheduler, timeout)
             return Client(scheduler, timeout=timeout)
-        except (OSError, TimeoutError, ValueError) as error:
+        except (OSError, ValueError) as error:
             raise StudyError(f"the dask scheduler at '{scheduler}' did not answer within {timeout:g} s "
                              f"({type(error).__name__}: {error}); is it running, and is the address "
                              "tcp://HOST:PORT?") from None

@@ -310,3 +310,12 @@ def test_the_deck_reference_is_current():
 
     assert (ROOT / "docs" / "decks.md").read_text() == deck_reference(), (
         "docs/decks.md is stale: python -m shellsim.deck.reference_doc > docs/decks.md")
+
+
+def test_a_mesh_point_named_all_is_refused():
+    """'all' is the set of every element: a [mesh] point by that name would change what
+    every table naming 'all' acts on."""
+    from .conftest import CLAMPED_PLATE
+
+    text = deck_text(*CLAMPED_PLATE).replace("[[boundary]]", "[mesh]\npoints = { all = [0.0, 0.0, 0.0] }\n\n[[boundary]]", 1)
+    assert "mesh.points.all: the geometry already has a set named 'all' (every element)" in problems_of(text)

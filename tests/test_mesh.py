@@ -400,6 +400,8 @@ def test_a_triangulated_cylinder_is_remeshed_into_quad9_on_its_surface(tmp_path)
 
 
 def test_a_surface_needs_an_element_size_and_two_names_cannot_share_a_loop(tmp_path):
+    """A surface without element_size, two boundary points finding one loop, a point far
+    from every loop and a loop named 'all' are each refused with a message naming the key."""
     from shellsim.deck import parse_deck
     from shellsim.errors import DeckError
 
@@ -409,6 +411,15 @@ def test_a_surface_needs_an_element_size_and_two_names_cannot_share_a_loop(tmp_p
     with pytest.raises(MeshError, match="find the same boundary loop"):
         build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.5\n'
               'boundaries = { a = [1.0, 0.0, 0.0], b = [0.0, 1.0, 0.1] }')
+    # a point in other units (here mm on a surface in m) finds no loop near it
+    with pytest.raises(MeshError, match=r"geometry.boundaries.inlet = \(1000, 0, 0\) is 999 from the nearest boundary "
+                                        r"loop of '.*cylinder.stl' \(near \(.*\), 1.99. across\)"):
+        build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.5\n'
+              'boundaries = { inlet = [1000.0, 0.0, 0.0] }')
+    # 'all' is every element's set, which would hide the loop's
+    with pytest.raises(DeckError, match="boundaries: 'all' names the set of every element"):
+        parse_deck(deck_text(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.5\n'
+                             'boundaries = { all = [1.0, 0.0, 0.0] }', ""))
 
 
 def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):

@@ -267,6 +267,8 @@ class MeshFile(Section):
         if not self.surface and (self.element_size is not None or self.boundaries):
             raise ValueError(f"element_size and boundaries are for a triangulated surface ({', '.join(SURFACE_SUFFIXES)}); "
                              f"'{self.path}' is read as a quad9 mesh")
+        if "all" in self.boundaries:  # the set of every element would hide it
+            raise ValueError("boundaries: 'all' names the set of every element; give the loop another name")
         return self
 
 

@@ -73,8 +73,9 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
             )
 
     for name in deck.mesh.points:
-        if name in (geometry_sets or {}):
-            problems.append(f"mesh.points.{name}: the geometry already has a set named '{name}'")
+        if name in (geometry_sets or {}) or name == "all":
+            problems.append(f"mesh.points.{name}: the geometry already has a set named '{name}'"
+                            + (" (every element)" if name == "all" else ""))
     taken = dict.fromkeys(list(geometry_sets or {}) + ["all"] + list(deck.mesh.points), "the geometry's or [mesh] points'")
     for i, table in enumerate(deck.cable):
         for name in table.declared_sets:

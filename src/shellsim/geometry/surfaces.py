@@ -85,6 +85,11 @@ def boundary_loops(x: np.ndarray, conn: np.ndarray, names: dict[str, tuple[float
             raise MeshError(f"geometry.boundaries.{name}: surface file '{path}' is closed; it has no open boundary")
         nearest = [min(np.linalg.norm(x[np.unique(edges)] - point, axis=1)) for edges in loops]
         loop = int(np.argmin(nearest))
+        across = float(np.ptp(x[np.unique(loops[loop])], axis=0).max())
+        if nearest[loop] > across:  # a point inside or on a loop is at most its width from it
+            raise MeshError(f"geometry.boundaries.{name} = {place(point)} is {nearest[loop]:.4g} from the nearest "
+                            f"boundary loop of '{path}' (near {place(centres[loop])}, {across:.4g} across): give a "
+                            "point on the loop or at its centre, in the surface's units")
         if loop in taken:
             raise MeshError(f"geometry.boundaries.{name} = {place(point)} and geometry.boundaries.{taken[loop]} "
                             f"find the same boundary loop, near {place(centres[loop])}")

@@ -451,3 +451,30 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
                                atol=1e-12)
     with pytest.raises(MeshError, match="material.axes.field = 'fibres'.*it has 'fibre'"):
         build_model(parse_deck(text.replace('field = "fibre"', 'field = "fibres"')), mesh)
+
+
+def test_facets_segmentation_leaves_are_cleaned_and_a_non_manifold_edge_is_named(tmp_path):
+    """A cylinder STL with what segmentation leaves in (a facet with a corner twice, one
+    collapsed to a point, repeats of five facets) is remeshed as the clean file is (gmsh
+    raised or hung on each); a fin on an inner edge, which makes it no surface, is refused
+    naming the edge's place."""
+    import meshio
+
+    from shellsim.geometry.surfaces import clean_facets
+    from shellsim.mesh_reading import read_triangles
+
+    clean = _cylinder_stl(tmp_path / "clean.stl", 1.0, 3.0, around=32, along=8)
+    points, triangles = read_triangles(clean)
+    lone = len(points)
+    messy = np.vstack([triangles, [[triangles[0, 0], triangles[0, 0], triangles[0, 1]]], [[lone, lone, lone]],
+                       triangles[:5]])
+    meshio.write(tmp_path / "messy.stl", meshio.Mesh(np.vstack([points, points[:1]]), [("triangle", messy)]))
+    meshes = [build(f'builder = "file"\npath = "{path.as_posix()}"\nelement_size = 0.3')[1]
+              for path in (clean, tmp_path / "messy.stl")]
+    assert meshes[0].n_elements == meshes[1].n_elements > 50
+    np.testing.assert_allclose(mid_surface_area(meshes[1]), mid_surface_area(meshes[0]), rtol=1e-9)
+    b, c = triangles[0, 1], triangles[0, 2]  # an inner edge of two facets
+    fin = np.vstack([triangles, [[b, c, lone]]])
+    with pytest.raises(MeshError, match=r"fin.stl' is not a surface: 1 edge\(s\) are shared by more than two facets, "
+                                        r"e.g. near \("):
+        clean_facets(np.vstack([points, [[5.0, 5.0, 1.0]]]), fin, tmp_path / "fin.stl")

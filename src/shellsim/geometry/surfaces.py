@@ -37,16 +37,17 @@ def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     """Quad9 nodes (n, 3) and connectivity (ne, 9) of the surface in ``path`` remeshed
     with elements of about ``size``, inside a gmsh session."""
     points, triangles = read_triangles(path)
+    triangles = clean_facets(points, triangles, path)
     surface = gmsh.model.addDiscreteEntity(2)
     gmsh.model.mesh.addNodes(2, surface, np.arange(1, len(points) + 1), points.ravel())
     gmsh.model.mesh.addElementsByType(surface, 2, [], (triangles + 1).ravel())
-    gmsh.model.mesh.classifySurfaces(np.radians(RIDGE_DEG), True, True, np.pi)
-    gmsh.model.mesh.createGeometry()
     for key, value in (("Mesh.MeshSizeMin", size), ("Mesh.MeshSizeMax", size),
                        ("Mesh.Algorithm", 8), ("Mesh.RecombinationAlgorithm", 3),
                        ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.SecondOrderLinear", 1)):
         gmsh.option.setNumber(key, value)
     try:
+        gmsh.model.mesh.classifySurfaces(np.radians(RIDGE_DEG), True, True, np.pi)
+        gmsh.model.mesh.createGeometry()
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(2)
     except Exception as error:  # gmsh raises a bare Exception with its last error
@@ -55,6 +56,25 @@ def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
                         "from the triangles' may need changing") from None
     x, conn, _, _ = extract(gmsh, f"surface file '{path}'")
     return onto_surface(points, triangles, x), conn
+
+
+def clean_facets(points: np.ndarray, triangles: np.ndarray, path: Path) -> np.ndarray:
+    """The facets (m', 3) of ``triangles`` (m, 3) on ``points`` (n, 3, coincident points
+    merged) that gmsh can take: those with a corner twice (collapsed to an edge or a point)
+    and repeats of another facet dropped, as segmentation leaves them. Raises MeshError
+    for an edge shared by more than two facets (a non-manifold surface), naming where."""
+    triangles = triangles[(triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
+                          & (triangles[:, 0] != triangles[:, 2])]
+    _, first = np.unique(np.sort(triangles, axis=1), axis=0, return_index=True)
+    triangles = triangles[np.sort(first)]
+    edges = np.sort(triangles[:, [[0, 1], [1, 2], [2, 0]]].reshape(-1, 2), axis=1)
+    unique_edges, count = np.unique(edges, axis=0, return_counts=True)
+    shared = unique_edges[count > 2]
+    if len(shared):
+        places = ", ".join(place(points[edge].mean(axis=0)) for edge in shared[:3])
+        raise MeshError(f"surface file '{path}' is not a surface: {len(shared)} edge(s) are shared by more than two "
+                        f"facets, e.g. near {places}; mend it (e.g. in MeshLab: Select non-manifold edges) first")
+    return triangles
 
 
 def onto_surface(points: np.ndarray, triangles: np.ndarray, nodes: np.ndarray) -> np.ndarray:

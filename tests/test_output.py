@@ -600,8 +600,8 @@ def test_mirror_needs_a_symmetry_plane_and_fibres_a_fibre_law():
 def test_mirror_names_its_planes_and_reflects_across_those_alone():
     """A symmetry boundary may hold a vessel's cut end in its plane: ``mirror = true`` is
     refused with the symmetry sets to choose from, a set that is no symmetry boundary's is
-    named, and the copies are made across the named planes only (two of Test 9's three:
-    four copies)."""
+    named, planes that do not meet at right angles are refused, and the copies are made
+    across the named planes only (two of Test 9's three: four copies)."""
     from shellsim.errors import DeckError
     from shellsim.output.mirror import mirror_planes, mirrors
 
@@ -612,6 +612,11 @@ def test_mirror_names_its_planes_and_reflects_across_those_alone():
     with pytest.raises(DeckError, match="'ends' is not the set of a symmetry boundary; they are 'sym_x', 'sym_y', "
                                         "'z0'"):
         parse_deck(text.replace("[output]\n", '[output]\nmirror = ["sym_x", "ends"]\n', 1))
+    # planes that do not meet at right angles would give overlapping copies
+    slanted = text.replace("normal = [1.0, 0.0, 0.0]", "normal = [0.866, 0.5, 0.0]", 1)
+    with pytest.raises(DeckError, match="the planes of 'sym_x' and 'sym_y' meet at 60 degrees; the model is mirrored "
+                                        "across planes at right angles only"):
+        parse_deck(slanted.replace("[output]\n", '[output]\nmirror = ["sym_x", "sym_y"]\n', 1))
     run = prepared(parse_deck(text.replace("[output]\n", '[output]\nmirror = ["sym_x", "z0"]\n', 1)))
     planes = mirror_planes(run.deck, run.mesh)
     normals = np.array([normal for normal, _ in planes])

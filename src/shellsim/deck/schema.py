@@ -8,8 +8,10 @@ deck (defaults filled) is what the program runs.
 from __future__ import annotations
 
 import json
+from itertools import combinations
 from typing import Annotated, ClassVar, Literal, Union, get_args
 
+import numpy as np
 from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from .curves import Curve
@@ -602,8 +604,16 @@ def _mirror_problems(mirror: bool | list[str], boundaries: list) -> list[str]:
                 "symmetry boundary may also hold a cut end in its plane, and a copy reflected there is no part "
                 "of the model)"]
     known = f"they are {', '.join(repr(name) for name in symmetric)}" if symmetric else "the deck has none"
-    return [f"output.mirror: '{name}' is not the set of a symmetry boundary; {known}"
-            for name in mirror or [] if name not in symmetric]
+    problems = [f"output.mirror: '{name}' is not the set of a symmetry boundary; {known}"
+                for name in mirror or [] if name not in symmetric]
+    normals = {b.set: np.asarray(b.normal, dtype=float) / np.linalg.norm(b.normal) for b in boundaries
+               if b.type == "symmetry" and b.set in (mirror or [])}
+    for (a, n_a), (b, n_b) in combinations(normals.items(), 2):
+        cosine = abs(float(n_a @ n_b))
+        if 1e-9 < cosine < 1.0 - 1e-9:  # reflections across planes at another angle make more copies, overlapping
+            problems.append(f"output.mirror: the planes of '{a}' and '{b}' meet at {np.degrees(np.arccos(cosine)):.4g} "
+                            "degrees; the model is mirrored across planes at right angles only")
+    return problems
 
 
 def _vessel_axes_problems(output: Output) -> list[str]:

@@ -689,3 +689,27 @@ def test_a_static_vtu_series_has_its_times_and_renders_and_its_summary_is_strict
         raise ValueError(f"not strict JSON: {constant}")
 
     json.loads((tmp_path / "out" / "summary.json").read_text(), parse_constant=refuse)
+
+
+def test_a_run_cut_short_judges_only_the_values_it_reached(tmp_path):
+    """The plate stopped at its frame at t = 0.25 (as Ctrl-C stops it) with two references
+    it meets there: the tip's value at t = 0.1, reached, is judged; its largest value over
+    the run is not (passed False, with a note), since the run did not see the rest."""
+    from shellsim.execute import run_scene
+
+    class StopAtSecondFrame(Listener):
+        def on_frame(self, run) -> None:
+            if run.sim.state.t >= 0.25:
+                raise KeyboardInterrupt
+
+    references = ''.join(f'\n[[reference]]\nquantity = "tip {name}"\nprobe = "tip"\n{measure}\nexpected = 1.0\n'
+                         f'tolerance = 1e9\nsource = "any value passes"\n'
+                         for name, measure in (("early", 'measure = "at_time"\ntime = 0.1'), ("largest", 'measure = "max"')))
+    deck_path = tmp_path / "plate.toml"
+    deck_path.write_text(PLATE + references)
+    run, summary = run_scene(load_deck(deck_path), deck_path, tmp_path, StopAtSecondFrame())
+    assert run.status == "interrupted"
+    early, largest = summary["reference"]
+    assert early["passed"] and early["computed"] is not None
+    assert not largest["passed"] and largest["computed"] is None
+    assert largest["note"].startswith("not judged: the run ended interrupted at t = 0.25, and its max is of the whole run")

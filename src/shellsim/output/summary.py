@@ -20,13 +20,20 @@ from .folder import write_atomically
 
 def reference_results(run: Run) -> list[dict]:
     """One entry per [reference] of the deck, from the recorded histories: a valve
-    measure's from the samples it was taken at."""
+    measure's from the samples it was taken at. A run that did not complete has only its
+    ``at_time`` values judged: a final value, an extreme or a peak over a run cut short
+    is not the run's, so those are not judged (not passed, with a note saying why)."""
     times = np.asarray(run.times)
     results = []
     for ref in run.deck.reference:
         values = np.asarray(run.history[ref.probe])
         taken = ~np.isnan(values) if ref.probe in VALVE_COLUMNS else slice(None)
-        results.append(check(ref, times[taken], values[taken]))
+        entry = check(ref, times[taken], values[taken])
+        if run.status != "completed" and ref.measure != "at_time":
+            entry |= {"computed": None, "error": None, "error_percent": None, "passed": False,
+                      "note": f"not judged: the run ended {run.status} at t = {run.sim.state.t:.6g}, and its "
+                              f"{ref.measure} is of the whole run"}
+        results.append(entry)
     return results
 
 

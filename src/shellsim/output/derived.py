@@ -24,19 +24,23 @@ def principal_stresses(sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return values[..., ::-1], np.swapaxes(vectors, -1, -2)[..., ::-1, :]
 
 
+def current_geometry(sim: Simulation, depths) -> tuple[np.ndarray, np.ndarray]:
+    """(positions (ne, nq, L, 3), Jacobians dx/d(r, s, t) (ne, nq, L, 3, 3)) at the current
+    shape, at the in-plane Gauss points of the L layers at thickness coordinates ``depths``."""
+    model, state, rule = sim.model, sim.state, sim.model.rule
+    nq = len(rule.wq)
+    at_depths = [layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], t)
+                 for t in depths]
+    return np.stack([p for p, _ in at_depths], axis=2), np.stack([j for _, j in at_depths], axis=2)
+
+
 def vessel_frames(sim: Simulation, axes, depths: np.ndarray) -> np.ndarray:
     """(ne, nq, len(depths), 3, 3) frames at the current shape, rows (hoop, axial, radial),
     at the in-plane Gauss points of the layers at thickness coordinates ``depths``: hoop
     the vessel ``axes``' circumferential direction (a tube's or a centreline's) projected
     on the lamina, radial the lamina normal, axial the third (:func:`~shellsim.model.lamina_axes`)."""
-    model, state, rule = sim.model, sim.state, sim.model.rule
-    nq = len(rule.wq)
-    frames = np.empty((model.n_elements, nq, len(depths), 3, 3))
-    for k, t in enumerate(depths):
-        position, jac = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq],
-                                       rule.dNs[:nq], t)
-        frames[:, :, k] = lamina_axes(jac, axes.preferred(position, {}))
-    return frames
+    position, jac = current_geometry(sim, depths)
+    return lamina_axes(jac, axes.preferred(position, {}))
 
 
 def normal_components(sigma: np.ndarray, frames: np.ndarray) -> np.ndarray:
@@ -47,15 +51,10 @@ def normal_components(sigma: np.ndarray, frames: np.ndarray) -> np.ndarray:
 def deformation_gradients(sim: Simulation, layers: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """(F, jac), each (ne, nq, len(layers), 3, 3), at the in-plane integration points of
     the ``layers`` (indices into the thickness rule): the current Jacobian jac = dx/d(r, s,
-    t) and the deformation gradient F = jac (dX/d(r, s, t))^-1."""
-    model, state, rule = sim.model, sim.state, sim.model.rule
-    nq = len(rule.wq)
-    F, jac = (np.empty((model.n_elements, nq, len(layers), 3, 3)) for _ in range(2))
-    for column, k in enumerate(layers):
-        jac[:, :, column] = layer_geometry(state.x, state.d, state.h, model.conn, rule.N[:nq], rule.dNr[:nq],
-                                           rule.dNs[:nq], rule.tz[k])[1]
-        F[:, :, column] = jac[:, :, column] @ model.body.jac0_inv[:, :nq, k]
-    return F, jac
+    t) (:func:`current_geometry`) and the deformation gradient F = jac (dX/d(r, s, t))^-1."""
+    nq = len(sim.model.rule.wq)
+    _, jac = current_geometry(sim, sim.model.rule.tz[layers])
+    return jac @ sim.model.body.jac0_inv[:, :nq][:, :, layers], jac
 
 
 def second_piola_in(frames0: np.ndarray, F: np.ndarray, sigma: np.ndarray) -> np.ndarray:

@@ -179,9 +179,11 @@ def _point_values(sim: Simulation, tensors: tuple[np.ndarray, ...], fields: list
     if {PK2, MATERIAL_STRESS} & set(fields):
         F, jac = deformation_gradients(sim, list(range(len(sim.model.rule.tz))))
         frames0 = sim.model.material.axes0
-        values[PK2] = second_piola_in(frames0, F, cauchy)
-        frames = current_material_frames(frames0, F, jac)
-        values[MATERIAL_STRESS] = frames @ cauchy @ np.swapaxes(frames, -1, -2)
+        if PK2 in fields:
+            values[PK2] = second_piola_in(frames0, F, cauchy)
+        if MATERIAL_STRESS in fields:
+            frames = current_material_frames(frames0, F, jac)
+            values[MATERIAL_STRESS] = frames @ cauchy @ np.swapaxes(frames, -1, -2)
     return {name: values[name] for name in fields if name in CELL_FIELDS}
 
 

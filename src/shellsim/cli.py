@@ -23,6 +23,7 @@ from . import __version__
 from .errors import OutputError, SceneTooLarge, ShellsimError, Terminated
 from .output.folder import output_folder
 from .signals import handling
+from .solver.stability import describe
 
 app = typer.Typer(
     help="Explicit dynamics of thin and thick soft-tissue shells (9-node continuum-based shell).",
@@ -296,9 +297,10 @@ def _run_report(result: dict, folder: Path) -> Table | str:
                + (f", volume change {result['volume_change_percent']:+.3f}%" if "volume_change_percent" in result else "")
                + f"; results in {escape(str(folder))}")
     title = f"{escape(result['title'])}: {result['status']}"
+    passed = [escape(describe(event)) for event in (static or {}).get("stability", [])]
     if not result["reference"]:
-        return f"{title}\n{caption}"
-    notes = [escape(f"{r['quantity']}: {r['note']}") for r in result["reference"] if "note" in r]
+        return "\n".join([title, *passed, caption])
+    notes = [*passed, *(escape(f"{r['quantity']}: {r['note']}") for r in result["reference"] if "note" in r)]
     table = Table(title=title, title_justify="left", caption="\n".join([*notes, caption]))
     for column in ("quantity", "computed", "expected", "error", "tolerance", "ok"):
         table.add_column(column)

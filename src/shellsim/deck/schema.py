@@ -180,11 +180,13 @@ class Static(Section):
     span). An iteration has converged when the residual force is within
     ``force_tolerance`` of the largest of the external and internal force norms and the
     residual's work on the correction within ``energy_tolerance`` of the step's first.
-    ``newton = "modified"`` keeps the last tangent (from earlier steps too) while each
-    iteration removes at least half of the residual and forms a new one where an
+    ``newton = "modified"`` forms the tangent at each step's start and keeps it while each
+    iteration removes at least half of the residual, forming a new one where an
     iteration does not (going back first when it made the residual larger): forming a
     tangent costs about forty residuals, so this takes more iterations and less time.
-    ``"full"`` forms the tangent at every iteration (quadratic convergence).
+    ``"full"`` forms the tangent at every iteration (quadratic convergence). The signs of
+    the pivots of each step's first tangent tell where the path passed a limit point or a
+    bifurcation: the run reports both (``summary.json``'s ``static.stability``).
 
     ``control = "arc_length"`` follows the equilibrium path through limit points instead
     (a snapping shell, a tube past its inflation maximum): each step moves the
@@ -193,9 +195,13 @@ class Static(Section):
     as long as the linear response to the
     first of ``increments``; later steps grow or shrink with the iterations they take,
     to at most four times the first, and are cut to a quarter when they fail (down to
-    ``min_increment`` of the first). The run's clock is then the load time's path length
-    (the load time until the first limit point); it ends at the first step that passes
-    ``end_time``, and history.csv's load factors tell the load reached."""
+    ``min_increment`` of the first), and shorter after a step where the path turned
+    sharply. A step that converges pointing back along the path is taken again shorter.
+    Where an output time or a knot of a load curve is within the next step's reach, a load
+    step goes there instead; where the curves hold or have ended, the load time moves on
+    with nothing to solve. The run's clock is then the load time's path length (the load
+    time until the first limit point); it ends at the first step that reaches ``end_time``,
+    and history.csv's load factors tell the load reached."""
 
     control: Literal["load", "arc_length"] = "load"
     newton: Literal["modified", "full"] = "modified"

@@ -90,12 +90,14 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
 
 def static_record(run: Run) -> dict:
     """A static solve's load steps: how many, the Newton iterations, tangents formed and
-    cut-backs over them, the largest relative residual a step ended with, and each step."""
+    cut-backs over them, the largest relative residual a step ended with, each step, and
+    where the path lost or regained stability (:meth:`.stability.StabilityWatch.events`)."""
     steps = [vars(step) for step in run.newton]
     return {"load_steps": len(steps), "iterations": sum(s["iterations"] for s in steps),
             "tangents": sum(s["tangents"] for s in steps),
             "cutbacks": sum(s["cutbacks"] for s in steps),
-            "largest_residual": max((s["residual"] for s in steps), default=0.0), "steps": steps}
+            "largest_residual": max((s["residual"] for s in steps), default=0.0),
+            "stability": run.stability.events() if run.stability is not None else [], "steps": steps}
 
 
 def contact_record(run: Run, output_seconds: float) -> dict:

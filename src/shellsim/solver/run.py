@@ -82,6 +82,7 @@ class Run:
     lowest: Worst | None = None  # the worst element seen over the run
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
+    stability: object | None = None  # a static solve's watch of its tangent's pivots (stability.StabilityWatch)
     load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
     tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
     valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS

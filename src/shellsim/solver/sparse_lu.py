@@ -49,6 +49,16 @@ class SymmetricPatternLU:
             self._lu = spla.splu(scaled, permc_spec="COLAMD")
 
     @property
+    def negative_pivots(self) -> int | None:
+        """The count of negative pivots, which is the count of negative eigenvalues of a
+        symmetric matrix (Sylvester's law of inertia: the symmetric scaling and the ordering
+        keep it, and diagonal pivoting makes U = D L^T); None when the factors pivoted off
+        the diagonal, which mixes the rows."""
+        if self.pivoted or not np.array_equal(self._lu.perm_r, self._lu.perm_c):
+            return None
+        return int(np.count_nonzero(self._lu.U.diagonal() < 0.0))
+
+    @property
     def entries(self) -> int:
         """The entries stored in the factors, L's and U's (the fill, with the matrix's own)."""
         return self._lu.L.nnz + self._lu.U.nnz

@@ -1,6 +1,9 @@
 """Static equilibrium by Newton-Raphson load steps (``solver.method = "static"``): the
 pseudo-time runs from 0 to the end time, the loads follow their curves in it, and each
-step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`.
+step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`. Each step forms
+its first tangent at the converged state it starts from; the signs of that tangent's
+pivots tell where the path loses stability (:mod:`.stability`), and the works between
+converged states are the run's energies (:mod:`.static_work`).
 
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
 turns to no number, or whose tangent is singular) is taken again from the last converged
@@ -22,6 +25,8 @@ from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, _frame, _record, ending, output_times
 from .sparse_lu import SymmetricPatternLU
+from .stability import StabilityWatch
+from .static_work import StaticWork
 
 CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
 #: Modified Newton forms a new tangent when an iteration leaves more than this share of the residual.
@@ -74,6 +79,8 @@ class NewtonSolver:
         self.extent = float(np.abs(run.model.x0).max())
         #: (tangent, its free columns' LU, round-off floor) the iterations use, None until the first
         self.tangent = None
+        self.work = StaticWork(self.eq)
+        run.stability = self.stability = StabilityWatch()
 
     def round_off(self, tangent) -> float:
         """The residual's round-off floor at a tangent (n_free, size): machine epsilon times
@@ -92,11 +99,20 @@ class NewtonSolver:
         self.last_residual = residual
         return residual
 
-    def linearised(self):
+    def linearised(self, at_converged: bool = False):
         """(tangent (n_free, size), the LU factors of its free columns, its round-off
-        floor) at the last evaluation."""
+        floor) at the last evaluation; ``at_converged``: the evaluation is of the converged
+        state, whose stability the factors' pivots are recorded as."""
         tangent = self.eq.tangent()
-        return tangent, _factorised(tangent[:, :self.n_free]), self.round_off(tangent)
+        lu = _factorised(tangent[:, :self.n_free])
+        if at_converged:
+            self.stability.observe(self.eq.converged.t, self.run.load_time, lu.negative_pivots)
+        return tangent, lu, self.round_off(tangent)
+
+    def observe_end(self) -> None:
+        """Record the stability of the last converged state, which no step starts from."""
+        self.eq.evaluate(self.run.load_time)
+        self.tangent = self.linearised(at_converged=True)
 
     def converged(self, norm: float, scale: float, energy: float, energy_scale: float, floor: float,
                   stalled: bool = False) -> bool:
@@ -116,8 +132,8 @@ class NewtonSolver:
         tangents formed, relative residual). Raises NotConverged with the reason.
         ``line_search``: see :meth:`_line_search`.
 
-        Full Newton forms the tangent at every iterate. Modified Newton keeps the last one
-        (from earlier steps too) while each iteration leaves at most SLOW of the residual;
+        Full Newton forms the tangent at every iterate. Modified Newton forms it at the
+        step's start and keeps it while each iteration leaves at most SLOW of the residual;
         when one leaves more it forms a new tangent there, or, when that iteration made the
         residual larger, goes back to the iterate before it and forms the tangent there."""
         # a wild iterate (an exponential law far out) has forces whose squares overflow: it is
@@ -152,13 +168,13 @@ class NewtonSolver:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale" + (f", and forces {scale / start_scale:.3g} times those the "
                                                            "step started from" if ran_away else ""))
-            fresh = self.tangent is None or settings.newton == "full" or norm > SLOW * previous
+            fresh = iteration == 0 or settings.newton == "full" or norm > SLOW * previous
             if fresh:
                 if before is not None and norm > previous:  # an old tangent led away: undo its correction
                     (before_state, pending, residual, norm) = before
                     before_state.restore(self.run.sim)
                     eq.evaluate(t)
-                self.tangent, before = self.linearised(), None
+                self.tangent, before = self.linearised(at_converged=iteration == 0), None
                 tangents += 1
             # the iterate before the correction, kept only where it may be gone back to
             start = Converged(self.run.sim) if line_search or not fresh else None
@@ -253,6 +269,7 @@ class NewtonSolver:
         self.run.sim.state.steps += 1
         self.eq.converged = Converged(self.run.sim)
         self.run.newton.append(step)
+        self.work.add_step()
 
 
 def solve_static(run: Run, listener: Listener | None = None, until: float | None = None) -> Run:
@@ -277,6 +294,7 @@ def solve_static(run: Run, listener: Listener | None = None, until: float | None
             follow_path(run, newton, listener)
         else:
             _load_steps(run, newton, listener, until or run.deck.solver.end_time)
+        newton.observe_end()
     return run
 
 
@@ -297,9 +315,18 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
         _frame(run, listener)
 
 
-def not_converged(run: Run, newton: NewtonSolver, where: str, why: str) -> str:
+#: What may get a load-controlled static solve past where it stopped.
+LOAD_ADVICE = ("If the load has reached the most the structure carries on this path (a limit point, where "
+               "more load steps stop at the same load), solver.static.control = \"arc_length\" follows the "
+               "path over it; otherwise a smaller solver.static.min_increment, or the explicit method, may help")
+#: What may get an arc-length solve past where it stopped.
+ARC_ADVICE = ("More solver.static.increments (a shorter first arc) or the explicit method past this point "
+              "may help")
+
+
+def not_converged(run: Run, newton: NewtonSolver, where: str, why: str, advice: str = LOAD_ADVICE) -> str:
     """The message of a step that cannot be solved: ``where`` in the load, why, the node
-    with the largest residual force and its place, and any folded element."""
+    with the largest residual force and its place, any folded element, and ``advice``."""
     s = run.sim.state
     message = f"the static solve did not converge {where}: {why}"
     local = newton.eq.unknowns.scatter(np.concatenate([newton.last_residual, np.zeros(newton.eq.unknowns.n_known)]))
@@ -311,5 +338,4 @@ def not_converged(run: Run, newton: NewtonSolver, where: str, why: str) -> str:
     folding = folding_diagnosis(run.quality.ratios(s.x, s.d, s.h), run.mesh.x, run.mesh.conn)
     if folding:
         message += f"; {folding}"
-    return message + ". A smaller solver.static.increments start, a load that stops short of a limit point, " \
-                     "or the explicit method past it may help"
+    return f"{message}. {advice}"

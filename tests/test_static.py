@@ -257,6 +257,7 @@ def test_a_step_that_cannot_converge_is_stopped_with_where(tmp_path):
     assert result.exit_code == 3, result.output
     said = " ".join(result.output.split())
     assert "did not converge" in said and "% of solver.end_time" in said and "largest residual force is at node" in said
+    assert "solver.static.control = \"arc_length\" follows the path over it" in said  # a limit point: load control stops
     history = (tmp_path / "out" / "history.csv").read_text().splitlines()
     assert len(history) >= 3  # the header, t = 0 and the steps before the limit point
 

@@ -13,11 +13,16 @@ in load time, central differences), and the change of load time dt that keeps th
 constraint: the root of a quadratic nearer to the step's direction (Crisfield 1981,
 "A fast incremental/iterative solution procedure that handles snap-through", Computers &
 Structures 13, 55-62). A step's direction follows the last one (the sign of du_t . Delta
-u_previous), so the path turns back at a limit point instead of reversing.
+u_previous), so the path turns back at a limit point instead of reversing; a step that
+converges pointing back along the path anyway is taken again shorter.
 
 The run's clock is the load time's path length, sum |Delta t|: it equals the load time
 until the first limit point and keeps rising after it, so histories and frames stay in
-order; the load reached is the history's load factor.
+order; the load reached is the history's load factor. Where the next output time or a
+knot of a load curve is within the next arc's reach, the step goes there by a load step
+instead (Newton at that load time), so frames land on their times and no step straddles
+a kink of a curve; where the curves hold (or have ended), the load time moves on to where
+they change again with nothing to solve.
 """
 
 from __future__ import annotations
@@ -28,13 +33,20 @@ from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..loads import external_forces
 from .run import Listener, Run, _frame, _record, output_times
-from .static import CUT, NewtonSolver, NewtonStep, NotConverged, not_converged
+from .equilibrium import Converged
+from .static import ARC_ADVICE, CUT, NewtonSolver, NewtonStep, NotConverged, not_converged
 
 #: Load-time share of the span by which the loads' rate is differenced.
 RATE_STEP = 1e-6
 #: Iterations a step aims at: the next step's length scales by sqrt(AIM / iterations),
 #: by a factor within GROWTH (Crisfield's rule), up to LONGEST times the first step's.
 AIM, GROWTH, LONGEST = 5, (0.5, 2.0), 4.0
+#: The largest turn of the path from one step to the next [rad]: after a step that turned
+#: more, the next is shorter in proportion, so the arcs follow the path's curvature.
+MOST_TURN = 0.15
+#: Steps in a row that move the clock by less than STALL of the end time end the run: the
+#: path makes no progress.
+STALLED_STEPS, STALL = 50, 1e-9
 
 
 class LoadRate:
@@ -73,8 +85,14 @@ class ArcLength:
         free = (u.index >= 0) & (u.index < u.n_free)
         self.translation = np.zeros(u.n_free, dtype=bool)
         self.translation[u.index[free & translation]] = True
+        curves = newton.run.model.curves
+        #: every curve's knots, where a load's rate may jump
+        self.knots = np.unique(np.concatenate([curves.t[c, :n] for c, n in enumerate(curves.length)] or [[]]))
         self.load_time = 0.0
+        self.forward = 1.0  # the way the load time went in the last step
         self.direction: np.ndarray | None = None  # the last converged step's translations
+        self.turn = 0.0  # the angle between the last two steps' translations [rad]
+        self.load_per_length = 0.0  # the last step's change of load time per translational length
 
     def first_length(self, load_step: float) -> float:
         """The translational length of the linear response to ``load_step`` of load time at
@@ -82,16 +100,62 @@ class ArcLength:
         self.eq.evaluate(self.load_time)
         _, lu, _ = self.newton.linearised()
         along = lu.solve(self.rate(self.load_time))[self.translation]
-        return abs(load_step) * float(np.linalg.norm(along))
+        length = abs(load_step) * float(np.linalg.norm(along))
+        self.load_per_length = abs(load_step) / max(length, 1e-300)
+        return length
 
-    def step(self, length: float) -> tuple[int, float, float]:
+    def _changing(self, t: float) -> bool:
+        """Whether the loads change just beyond load time t, the way the path goes."""
+        return bool(np.any(self.rate(t + self.forward * 4.0 * self.rate.step)))
+
+    def hold_end(self) -> float | None:
+        """None while the loads change ahead; where they hold, the load time at which
+        they change again the way the path goes (+-inf: never)."""
+        t = self.load_time
+        if self._changing(t):
+            return None
+        ahead = self.knots[(self.knots - t) * self.forward > 0.0][::int(self.forward)]
+        return next((float(k) for k in ahead if self._changing(k)), self.forward * np.inf)
+
+    def next_knot(self) -> float:
+        """The load time of the next knot of a curve the way the path goes (+-inf: none)."""
+        ahead = self.knots[(self.knots - self.load_time) * self.forward > 1e-12 * self.rate.step]
+        if not len(ahead):
+            return self.forward * np.inf
+        return float(ahead[0] if self.forward > 0 else ahead[-1])
+
+    def next_stop(self, clock: float, marks: np.ndarray) -> float:
+        """The load time of the nearest place ahead a step should land on: the next knot
+        of a curve, or where the clock (now ``clock``) reaches the next of ``marks``."""
+        t = self.load_time
+        stops = [self.next_knot(), *(t + self.forward * (m - clock) for m in marks[marks > clock])]
+        return min(stops, key=lambda stop: abs(stop - t))
+
+    def moved(self, before: Converged) -> None:
+        """The state has converged at ``self.load_time`` from ``before`` by other means
+        (a load step, a hold): the path's direction is that move's."""
+        u = self.eq.unknowns
+        sim = self.newton.run.sim
+        change = u.gather(u.to_local(sim.state.x - before.arrays["x"], sim.state.theta - before.arrays["theta"]))
+        self._follow(change[:u.n_free][self.translation])
+
+    def _follow(self, translations: np.ndarray) -> None:
+        """The last step's translations (n_translations,): its turn from the one before."""
+        if self.direction is not None and np.any(translations) and np.any(self.direction):
+            cosine = translations @ self.direction / (np.linalg.norm(translations) * np.linalg.norm(self.direction))
+            self.turn = float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+        if np.any(translations):
+            self.direction = translations
+
+    def step(self, length: float, stop: float) -> tuple[int, float, float]:
         """Equilibrium a translational distance ``length`` along the path; returns
-        (iterations, relative residual, change of load time). Raises NotConverged; the
-        state is then wherever the iterations left it."""
+        (iterations, relative residual, change of load time). Raises NotConverged when it
+        does not converge, converges pointing back along the path, or passes the load
+        time ``stop`` (a knot); the state is then wherever the iterations left it."""
         eq, newton, m = self.eq, self.newton, self.translation
         start = t = self.load_time
         eq.evaluate(t)
-        _, lu, floor = newton.linearised()
+        _, lu, floor = newton.linearised(at_converged=True)
         rate = self.rate(t)
         along = lu.solve(rate)
         sign = 1.0 if self.direction is None or along[m] @ self.direction >= 0.0 else -1.0
@@ -109,9 +173,14 @@ class ArcLength:
             # the energy against the work of the force scale over the step: the predictor's own
             # work vanishes at a limit point, where the load's change does
             if newton.converged(norm, scale, energy, scale * length, floor):
+                if (t - stop) * (start - stop) < 0.0:
+                    raise NotConverged(f"the step passed load time {stop:.6g}, a knot of a load curve")
+                if self.direction is not None and total[m] @ self.direction < 0.0:
+                    raise NotConverged("the step turned back along the path it came by")
                 newton.held_apart(t)
-                self.direction = total[m]
-                self.load_time = t
+                self._follow(total[m])
+                self.load_time, self.forward = t, (1.0 if t >= start else -1.0)
+                self.load_per_length = abs(t - start) / length
                 return iteration, norm / max(scale, 1e-300), t - start
             _, lu, floor = newton.linearised()
             balance, along = lu.solve(residual), lu.solve(self.rate(t))
@@ -123,16 +192,43 @@ class ArcLength:
         raise NotConverged(f"{self.settings.max_iterations} iterations left a residual of "
                            f"{norm / max(scale, 1e-300):.3g} of the force scale")
 
-    def reach(self, length: float, first: float) -> tuple[NewtonStep, float]:
+    def land(self, stop: float, length: float) -> NewtonStep | None:
+        """A load step to the load time ``stop`` when the next arc of ``length`` would
+        reach it (by the last step's load per length); None when it would not, or the load
+        step does not converge (a limit point before it): the state is then as before."""
+        if abs(stop - self.load_time) > self.load_per_length * length:
+            return None
+        sim, before = self.newton.run.sim, self.eq.converged
+        try:
+            iterations, tangents, residual = self.newton.step(stop)
+        except NotConverged:
+            before.restore(sim)
+            return None
+        change, self.load_time = stop - self.load_time, stop
+        self.forward = 1.0 if change >= 0.0 else -1.0
+        self.moved(before)
+        return NewtonStep(t=sim.state.t + abs(change), load_time=stop, iterations=iterations, tangents=tangents,
+                          residual=residual, cutbacks=0)
+
+    def hold(self, until: float, clock_to_mark: float) -> NewtonStep:
+        """The load time moved on to ``until`` (or by ``clock_to_mark``, the clock's way to
+        the next output time, when nearer) through loads that hold: the state stays in
+        equilibrium."""
+        change = min(abs(until - self.load_time), clock_to_mark)
+        self.load_time += self.forward * change
+        return NewtonStep(t=self.newton.run.sim.state.t + change, load_time=self.load_time, iterations=0,
+                          tangents=0, residual=0.0, cutbacks=0)
+
+    def reach(self, length: float, first: float, stop: float) -> tuple[NewtonStep, float]:
         """A converged step from the converged state, tried at ``length`` and cut back
-        until it converges; returns the step (its clock t past the state's by the change
-        of load time) and the length it was taken at. Raises NumericalError when the
-        length falls below ``min_increment`` of the ``first``."""
+        until it converges short of the load time ``stop``; returns the step (its clock t
+        past the state's by the change of load time) and the length it was taken at.
+        Raises NumericalError when the length falls below ``min_increment`` of the ``first``."""
         sim = self.newton.run.sim
         cutbacks = 0
         while True:
             try:
-                iterations, residual, change = self.step(length)
+                iterations, residual, change = self.step(length, stop)
                 return NewtonStep(t=sim.state.t + abs(change), load_time=self.load_time, iterations=iterations,
                                   tangents=iterations, residual=residual, cutbacks=cutbacks), length
             except NotConverged as why:
@@ -142,7 +238,8 @@ class ArcLength:
                 if length < self.settings.min_increment * first:
                     where = (f"along the path from load time {self.load_time:.6g} (clock t = {sim.state.t:.6g}) "
                              f"even in arc lengths of {self.settings.min_increment:g} of the first")
-                    raise NumericalError(not_converged(self.newton.run, self.newton, where, str(why))) from None
+                    raise NumericalError(not_converged(self.newton.run, self.newton, where, str(why),
+                                                       ARC_ADVICE)) from None
 
     def _padded(self, free: np.ndarray) -> np.ndarray:
         """A correction of the free unknowns, with the prescribed ones (held) appended."""
@@ -166,18 +263,40 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
     """Arc-length steps from the converged state until the clock (the load time's path
     length) passes the end time; a frame after each step that passes an output time.
     The first step is as long as the linear response to the first load step of
-    ``solver.static.increments``, and no later step is longer than LONGEST of it."""
+    ``solver.static.increments``; no later step is longer than LONGEST of it. Raises
+    NumericalError where a step cannot be solved, where the path runs back to loads that
+    no longer change, or after STALLED_STEPS steps that barely move the clock."""
     sim, end = run.sim, run.deck.solver.end_time
     arc = ArcLength(newton)
-    first = length = arc.first_length(end / run.deck.solver.static.increments)
+    first = length = None
     marks = output_times(run.deck)
+    stalled = 0
     while sim.state.t < end - 1e-12 * end:
         before = sim.state.t
-        step, length = arc.reach(length, first)
+        held = arc.hold_end()
+        if held is not None:
+            if arc.forward < 0.0 and np.isinf(held):
+                raise NumericalError(f"the path turned back to load time {arc.load_time:.6g} (clock t = "
+                                     f"{before:.6g}), below which the loads do not change: arc length cannot "
+                                     "follow it further")
+            step = arc.hold(held, marks[marks > before + 1e-12 * end][0] - before)  # marks end at the end time
+        else:
+            if first is None:
+                first = length = arc.first_length(end / run.deck.solver.static.increments)
+            stop = arc.next_stop(before, marks)
+            step = arc.land(stop, length)
+            if step is None:
+                step, length = arc.reach(length, first, arc.next_knot())
+                if step.cutbacks == 0:
+                    length = length * float(np.clip(np.sqrt(AIM / max(step.iterations, 1)), *GROWTH))
+                length = min(length, LONGEST * first, length * MOST_TURN / max(arc.turn, 1e-300))
         sim.state.t = step.t
         newton.commit(step)
         _record(run, listener)
         if np.any((marks > before) & (marks <= sim.state.t + 1e-12 * end)):
             _frame(run, listener)
-        if step.cutbacks == 0:
-            length = min(length * float(np.clip(np.sqrt(AIM / max(step.iterations, 1)), *GROWTH)), LONGEST * first)
+        stalled = stalled + 1 if sim.state.t - before < STALL * end else 0
+        if stalled >= STALLED_STEPS:
+            raise NumericalError(f"arc length made no progress: {stalled} steps in a row moved the clock by less "
+                                 f"than {STALL:g} of solver.end_time, at load time {arc.load_time:.6g} "
+                                 f"(clock t = {sim.state.t:.6g})")

@@ -160,3 +160,18 @@ def test_a_static_run_s_works_are_the_balloon_s_stored_energy():
     internal, external = run.energies[-1][INTERNAL], run.energies[-1][EXTERNAL]
     assert internal == pytest.approx(stored, rel=0.01)
     assert external == pytest.approx(internal, rel=1e-6)
+
+
+def test_load_control_jumping_over_the_roof_s_snap_says_so():
+    """The 4 x 4 roof by load steps to P_max: past the first limit point no equilibrium is
+    near, and a step lands on the far branch after the snap. The run reports that jump,
+    between load times that bracket Sze's limit load, and ends on Sze's far branch: the
+    crown's deflection at P_max within 0.5% of their curve's (28.876, between their points
+    at 0.9643 and 1.0835 P_max)."""
+    run = run_deck(_deck("hinged_roof_snap_4x4", {'control = "arc_length", ': "", "end_time = 1.8": "end_time = 1.0"}))
+    assert run.status == "completed"
+    jumps = [e for e in run.stability.events() if e["kind"] == "jump"]
+    assert len(jumps) == 1
+    assert jumps[0]["load_time_from"] <= 0.7421 * 1.02 and jumps[0]["load_time_to"] >= 0.7421
+    far = np.interp(1.0, [0.9643, 1.0835], [28.663, 29.374])  # Sze's last two points, past the table above
+    assert -run.history["crown_deflection"][-1] == pytest.approx(far, rel=0.005)

@@ -180,13 +180,15 @@ class Static(Section):
     span). An iteration has converged when the residual force is within
     ``force_tolerance`` of the largest of the external and internal force norms and the
     residual's work on the correction within ``energy_tolerance`` of the step's first.
-    ``newton = "modified"`` forms the tangent at each step's start and keeps it while each
-    iteration removes at least half of the residual, forming a new one where an
+    ``newton = "modified"`` keeps the last tangent (from earlier steps too) while each
+    iteration removes at least half of the residual and forms a new one where an
     iteration does not (going back first when it made the residual larger): forming a
     tangent costs about forty residuals, so this takes more iterations and less time.
-    ``"full"`` forms the tangent at every iteration (quadratic convergence). The signs of
-    the pivots of each step's first tangent tell where the path passed a limit point or a
-    bifurcation: the run reports both (``summary.json``'s ``static.stability``).
+    ``"full"`` forms the tangent at every iteration (quadratic convergence). A tangent
+    formed at a converged state at the start, after every load step of ``increments``
+    and at the end tells by the signs of its pivots where the path passed a limit point
+    or a bifurcation: the run reports both, and a step that jumped (moved the shape ten
+    times as far as its first correction) (``summary.json``'s ``static.stability``).
 
     ``control = "arc_length"`` follows the equilibrium path through limit points instead
     (a snapping shell, a tube past its inflation maximum): each step moves the

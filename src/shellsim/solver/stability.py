@@ -30,6 +30,7 @@ class StabilityWatch:
 
     def __init__(self):
         self.observations: list[Observation] = []
+        self.jumps: list[dict] = []
 
     def observe(self, t: float, load_time: float, negative_pivots: int | None) -> None:
         """Record the count at the converged state at clock t (None: unknown, the factors
@@ -38,11 +39,19 @@ class StabilityWatch:
             return
         self.observations.append(Observation(t, load_time, negative_pivots))
 
+    def jumped(self, t: float, load_time_from: float, load_time_to: float, ratio: float) -> None:
+        """Record a load step from the converged state at clock t that moved the shape
+        ``ratio`` times as far as its tangent predicted: it may have jumped over a
+        snap-through, which it did not follow."""
+        self.jumps.append({"kind": "jump", "t_from": t, "load_time_from": load_time_from,
+                           "load_time_to": load_time_to, "ratio": ratio})
+
     def events(self) -> list[dict]:
         """Each change of the count: the converged states it lies between (clock and load
         time), the counts before and after, and its kind, 'limit point' where the load's
         change turns back within a step of it, 'bifurcation' where the count rises with no
-        such turn, 'restabilised' where it falls with none."""
+        such turn, 'restabilised' where it falls with none; and each 'jump' (:meth:`jumped`),
+        in the order of their load times."""
         seen, found = self.observations, []
         for i in range(1, len(seen)):
             before, after = seen[i - 1], seen[i]
@@ -56,12 +65,16 @@ class StabilityWatch:
             found.append({"kind": kind, "t_from": before.t, "t_to": after.t, "load_time_from": before.load_time,
                           "load_time_to": after.load_time, "negative_pivots_from": before.negative_pivots,
                           "negative_pivots_to": after.negative_pivots})
-        return found
+        return sorted(found + self.jumps, key=lambda event: event["t_from"])
 
 
 def describe(event: dict) -> str:
     """One line for the console about a stability event of :meth:`StabilityWatch.events`."""
     where = f"between load time {event['load_time_from']:.6g} and {event['load_time_to']:.6g}"
+    if event["kind"] == "jump":
+        return (f"jump {where}: the load step moved the shape {event['ratio']:.3g} times as far as the tangent at "
+                "its start predicted, so the path may snap through there, passed by a jump rather than followed; "
+                "solver.static.control = \"arc_length\" follows it")
     counts = f"{event['negative_pivots_from']} -> {event['negative_pivots_to']} negative pivots"
     if event["kind"] == "bifurcation" and event["negative_pivots_from"] == 0:
         return (f"bifurcation passed {where} ({counts}): the tangent stiffness is no longer positive definite, "

@@ -1,9 +1,11 @@
 """Static equilibrium by Newton-Raphson load steps (``solver.method = "static"``): the
 pseudo-time runs from 0 to the end time, the loads follow their curves in it, and each
-step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`. Each step forms
-its first tangent at the converged state it starts from; the signs of that tangent's
-pivots tell where the path loses stability (:mod:`.stability`), and the works between
-converged states are the run's energies (:mod:`.static_work`).
+step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`. The signs of the
+pivots of a tangent formed at a converged state, with its own load, tell where the path
+loses stability (:mod:`.stability`): load control forms one wherever the load time has
+moved on by a load step of ``increments`` since the last, and at the end, and modified
+Newton goes on with it; arc length forms one at every step's start anyway. The works
+between converged states are the run's energies (:mod:`.static_work`).
 
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
 turns to no number, or whose tangent is singular) is taken again from the last converged
@@ -38,6 +40,10 @@ LINE_SEARCH_HALVINGS = 4
 #: (k2 = 524.6 puts forces near 1e180) can balance a pressure to 1e-6 of forces that large
 #: and pass as converged. Steps that prescribe motion are not held to it.
 RUNAWAY = 1e6
+#: A step whose shape moved more than this many times as far as its first correction (the
+#: tangent's prediction) jumped: load control passes a small snap-through so, landing on
+#: another part of the path without following it.
+JUMP = 10.0
 
 
 @dataclass
@@ -109,8 +115,10 @@ class NewtonSolver:
             self.stability.observe(self.eq.converged.t, self.run.load_time, lu.negative_pivots)
         return tangent, lu, self.round_off(tangent)
 
-    def observe_end(self) -> None:
-        """Record the stability of the last converged state, which no step starts from."""
+    def observe(self) -> None:
+        """Record the stability of the converged state: a tangent there, with its own load
+        (a follower pressure's stiffness is the new load's at a step's first iterate), which
+        modified Newton goes on with."""
         self.eq.evaluate(self.run.load_time)
         self.tangent = self.linearised(at_converged=True)
 
@@ -132,8 +140,8 @@ class NewtonSolver:
         tangents formed, relative residual). Raises NotConverged with the reason.
         ``line_search``: see :meth:`_line_search`.
 
-        Full Newton forms the tangent at every iterate. Modified Newton forms it at the
-        step's start and keeps it while each iteration leaves at most SLOW of the residual;
+        Full Newton forms the tangent at every iterate. Modified Newton keeps the last one
+        (from earlier steps too) while each iteration leaves at most SLOW of the residual;
         when one leaves more it forms a new tangent there, or, when that iteration made the
         residual larger, goes back to the iterate before it and forms the tangent there."""
         # a wild iterate (an exponential law far out) has forces whose squares overflow: it is
@@ -163,18 +171,20 @@ class NewtonSolver:
                 ran_away = scale > RUNAWAY * start_scale
                 if not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
                     self.held_apart(t)
+                    if self._moved() > JUMP * predicted:
+                        self.stability.jumped(self.eq.converged.t, self.run.load_time, t, self._moved() / predicted)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "
                                    "of the force scale" + (f", and forces {scale / start_scale:.3g} times those the "
                                                            "step started from" if ran_away else ""))
-            fresh = iteration == 0 or settings.newton == "full" or norm > SLOW * previous
+            fresh = self.tangent is None or settings.newton == "full" or norm > SLOW * previous
             if fresh:
                 if before is not None and norm > previous:  # an old tangent led away: undo its correction
                     (before_state, pending, residual, norm) = before
                     before_state.restore(self.run.sim)
                     eq.evaluate(t)
-                self.tangent, before = self.linearised(at_converged=iteration == 0), None
+                self.tangent, before = self.linearised(), None
                 tangents += 1
             # the iterate before the correction, kept only where it may be gone back to
             start = Converged(self.run.sim) if line_search or not fresh else None
@@ -187,11 +197,17 @@ class NewtonSolver:
             if first_energy is None:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
             eq.move(np.concatenate([correction, pending]))
+            if iteration == 0:
+                predicted = max(self._moved(), 1e-300)
             eq.evaluate(t)
             if line_search and fresh and not np.any(pending):
                 self._line_search(t, start, correction, norm)
             pending = np.zeros_like(known)
         raise AssertionError("unreachable")
+
+    def _moved(self) -> float:
+        """How far the nodes are from the converged state: the norm of their moves."""
+        return float(np.linalg.norm(self.run.sim.state.x - self.eq.converged.arrays["x"]))
 
     def _step_or_search(self, t: float) -> tuple[int, int, float]:
         """:meth:`step` to t; when it fails, again from the same start with the line search.
@@ -294,7 +310,7 @@ def solve_static(run: Run, listener: Listener | None = None, until: float | None
             follow_path(run, newton, listener)
         else:
             _load_steps(run, newton, listener, until or run.deck.solver.end_time)
-        newton.observe_end()
+        newton.observe()
     return run
 
 
@@ -304,11 +320,16 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
     largest = end / run.deck.solver.static.increments
     length = largest
     landings = output_times(run.deck)
+    newton.observe()  # the first step's tangent, at the start
+    observed = sim.state.t  # the load time of the last stability check
     for landing in np.append(landings[landings < end], end):
         while sim.state.t < landing - 1e-12 * end:
             step, length = newton.reach(landing, length)
             sim.state.t = step.t
             newton.commit(step)
+            if step.t >= observed + largest * (1.0 - 1e-9) and step.t < end * (1.0 - 1e-12):
+                newton.observe()  # the end's is the run's last
+                observed = step.t
             _record(run, listener)
             if step.tangents <= GROWTH_TANGENTS and step.cutbacks == 0:
                 length = min(length * GROW, largest)

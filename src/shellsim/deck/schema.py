@@ -187,8 +187,8 @@ class Static(Section):
     ``"full"`` forms the tangent at every iteration (quadratic convergence). A tangent
     formed at a converged state at the start, after every load step of ``increments``
     and at the end tells by the signs of its pivots where the path passed a limit point
-    or a bifurcation: the run reports both, and a step that jumped (moved the shape ten
-    times as far as its first correction) (``summary.json``'s ``static.stability``).
+    or a bifurcation; the run reports both, and any step that jumped (moved the shape ten
+    times as far as its first correction), in ``summary.json``'s ``static.stability``.
 
     ``control = "arc_length"`` follows the equilibrium path through limit points instead
     (a snapping shell, a tube past its inflation maximum): each step moves the

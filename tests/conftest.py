@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -174,3 +175,17 @@ def scene():
     from shellsim.deck import parse_deck
 
     return lambda geometry, extra="": parse_deck(deck_text(geometry, extra))
+
+
+def cylinder_stl(path: Path, radius: float, length: float, around: int = 128, along: int = 48) -> Path:
+    """An open cylinder about z, z in [0, length], as 2 x around x along facets."""
+    import meshio
+
+    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
+    z = np.linspace(0.0, length, along + 1)
+    points = np.array([[radius * np.cos(p), radius * np.sin(p), h] for h in z for p in phi])
+    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
+    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
+    triangles = np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
+    meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
+    return path

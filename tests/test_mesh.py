@@ -18,7 +18,7 @@ from shellsim.geometry import build_mesh
 from shellsim.geometry.session import gmsh_session
 from shellsim.mesh import jacobian_determinants, mid_surface_area
 
-from .conftest import deck_text
+from .conftest import cylinder_stl, deck_text
 
 T = 0.01  # section thickness of the test decks
 RM = 1.0 + T / 2  # tube mid-surface radius for inner radius 1
@@ -365,26 +365,12 @@ def test_mesh_png_is_not_blank(tmp_path):
     assert pixels.std() > 20  # a blank (uniform) image has zero spread
 
 
-def _cylinder_stl(path: Path, radius: float, length: float, around: int = 128, along: int = 48) -> Path:
-    """An open cylinder about z, z in [0, length], as 2 x around x along facets."""
-    import meshio
-
-    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
-    z = np.linspace(0.0, length, along + 1)
-    points = np.array([[radius * np.cos(p), radius * np.sin(p), h] for h in z for p in phi])
-    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
-    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
-    triangles = np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
-    meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
-    return path
-
-
 def test_a_triangulated_cylinder_is_remeshed_into_quad9_on_its_surface(tmp_path):
     """An STL of an open cylinder (R = 1, L = 3, 128 facets around) remeshed with elements
     of 0.3: 9-node quads only, every node within 0.1% of the radius (the facets' chords
     sit 0.03% inside it), the area within 0.1% of 2 pi R L, directors pointing outward,
     and the two open ends as edge sets: the one the deck names by a point, and open_1."""
-    stl = _cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0)
+    stl = cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0)
     _, mesh = build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 0.3\n'
                     'boundaries = { inlet = [1.0, 0.0, 0.0] }')
     assert mesh.conn.shape[1] == 9 and mesh.n_elements > 100
@@ -405,7 +391,7 @@ def test_a_surface_needs_an_element_size_and_two_names_cannot_share_a_loop(tmp_p
     from shellsim.deck import parse_deck
     from shellsim.errors import DeckError
 
-    stl = _cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0, around=32, along=8)
+    stl = cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0, around=32, along=8)
     with pytest.raises(DeckError, match="element_size"):
         parse_deck(deck_text(f'builder = "file"\npath = "{stl.as_posix()}"', ""))
     with pytest.raises(MeshError, match="find the same boundary loop"):
@@ -463,7 +449,7 @@ def test_facets_segmentation_leaves_are_cleaned_and_a_non_manifold_edge_is_named
     from shellsim.geometry.surfaces import clean_facets
     from shellsim.mesh_reading import read_triangles
 
-    clean = _cylinder_stl(tmp_path / "clean.stl", 1.0, 3.0, around=32, along=8)
+    clean = cylinder_stl(tmp_path / "clean.stl", 1.0, 3.0, around=32, along=8)
     points, triangles = read_triangles(clean)
     lone = len(points)
     messy = np.vstack([triangles, [[triangles[0, 0], triangles[0, 0], triangles[0, 1]]], [[lone, lone, lone]],

@@ -37,13 +37,11 @@ def build_mesh(deck: Deck, base_dir: Path | None = None) -> Mesh:
     lines = np.zeros((0, 2), dtype=np.int64)  # a mesh file's cables
     remeshed = g.builder == "file" and g.surface
     if remeshed:
-        from .session import gmsh_session
         from .surfaces import boundary_loops, remesh
 
         path = resolve_mesh_path(deck, base_dir)
         source = f"surface file '{path}'"
-        with gmsh_session(name="surface") as gmsh:
-            x, conn = remesh(gmsh, path, g.element_size)
+        x, conn = remesh(path, g.element_size)
         sets = boundary_loops(x, conn, g.boundaries, path)
         preferred = x[conn[:, 8]] - x.mean(axis=0)  # outward, for a vessel
     elif g.builder == "file":

@@ -9,6 +9,12 @@ not). Every node is then moved onto the plane of the nearest facet, the second-o
 ones from straight edges: gmsh places the split's new corners on the chords, and its own
 second-order placement through the reparametrisation can land a node across a patch's
 seam, folding its element.
+gmsh's mesh of a closed tube has slivers and folds along the seams of its
+reparametrisation at some sizes: they are smoothed out (:mod:`.untangle`), and where some
+stay the size is nudged, then the mesh is made by splitting every element of a mesh twice
+as coarse into four (``ATTEMPTS``). gmsh runs in a child process, so a Ctrl-C or SIGTERM
+stops it at once, and a size that would make an absurd number of elements (one in other
+units than the surface's) is refused before it starts.
 The surface's open boundary loops (a vessel's ends) become edge sets, named by the deck
 (``boundaries``: the loop nearest each point) or ``open_1``, ``open_2``, ... along the
 surface's longest extent.
@@ -25,24 +31,85 @@ from ..errors import MeshError, place
 from ..mesh import EDGES, NamedSet
 from ..mesh_reading import read_triangles
 from .gmsh_extract import extract
+from .untangle import bad_elements, untangled
 
 #: Dihedral angle above which gmsh splits the surface into patches (degrees): a ridge
 #: sharper than this stays a ridge.
 RIDGE_DEG = 40.0
 #: Name prefix of the open boundary loops the deck does not name.
 LOOP_PREFIX = "open_"
+#: Elements per square of the element size that the remeshing makes (1.2 to 1.4 on the
+#: shipped carotid); the most elements a surface is remeshed into, and the count a
+#: suggested size aims at when that is exceeded.
+ELEMENTS_PER_SQUARE = 1.3
+MOST_ELEMENTS, SUGGESTED_ELEMENTS = 1_000_000, 10_000
+#: The meshes tried in turn until one has no bad element: (split, share of the element
+#: size), full quads at the size and nudged from it, then split from twice the size.
+NUDGES = (1.0, 0.97, 1.03, 0.94, 1.06, 0.91, 1.09)
+ATTEMPTS = tuple((False, n) for n in NUDGES) + tuple((True, n) for n in NUDGES)
 
 
-def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
+def remesh(path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     """Quad9 nodes (n, 3) and connectivity (ne, 9) of the surface in ``path`` remeshed
-    with elements of about ``size``, inside a gmsh session."""
+    with elements of about ``size``, by gmsh in a child process (a stop ends it at once).
+    Raises MeshError for a surface that cannot be remeshed, or whose area at ``size``
+    would make more than MOST_ELEMENTS elements."""
     points, triangles = read_triangles(path)
     triangles = clean_facets(points, triangles, path)
+    area = float(np.linalg.norm(np.cross(points[triangles[:, 1]] - points[triangles[:, 0]],
+                                         points[triangles[:, 2]] - points[triangles[:, 0]]), axis=1).sum() / 2)
+    expected = ELEMENTS_PER_SQUARE * area / size**2
+    if expected > MOST_ELEMENTS:
+        suggested = np.sqrt(ELEMENTS_PER_SQUARE * area / SUGGESTED_ELEMENTS)
+        raise MeshError(f"geometry.element_size = {size:g} would remesh surface file '{path}' (area {area:.4g}, "
+                        f"{np.ptp(points, axis=0).max():.4g} across) into about {expected:.3g} elements, more than "
+                        f"{MOST_ELEMENTS:,}: is the size in the surface's units? About {suggested:.3g} gives "
+                        f"{SUGGESTED_ELEMENTS:,}")
+    from .child import in_child
+
+    return in_child(_remesh_in_gmsh, points, triangles, size, path)
+
+
+def _remesh_in_gmsh(points: np.ndarray, triangles: np.ndarray, size: float, path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`remesh`'s gmsh sessions (ATTEMPTS): the size first, then nudged by each of
+    NUDGES in turn while the mesh keeps bad elements its mending could not mend (gmsh's meshes
+    differ from size to size, and a bad element at one is seldom at the next), then the
+    same with every element split into four from twice the size (no element then has
+    three corners on an open end, which recombination leaves there at some sizes with a
+    straight angle no mending can open); the first mesh with no bad element, else the
+    one with fewest, for the checks that follow to name."""
+    from .session import gmsh_session
+
+    best, failure = None, None
+    for split, nudge in ATTEMPTS:
+        try:
+            with gmsh_session(name="surface") as gmsh:
+                x, conn = _quads(gmsh, points, triangles, size * nudge, path, split)
+        except MeshError as error:
+            failure = failure or error
+            continue
+        bad = len(bad_elements(x, conn))
+        if best is None or bad < best[0]:
+            best = (bad, x, conn)
+        if not bad:
+            break
+    if best is None:
+        raise failure
+    return best[1], best[2]
+
+
+def _quads(gmsh: Any, points: np.ndarray, triangles: np.ndarray, size: float, path: Path,
+           split: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Quad9 nodes and connectivity of the facets remeshed in the gmsh session ``gmsh``;
+    ``split``: recombined at twice the size and every element split into four (gmsh's
+    subdivision), else recombined into full quads at the size."""
     surface = gmsh.model.addDiscreteEntity(2)
     gmsh.model.mesh.addNodes(2, surface, np.arange(1, len(points) + 1), points.ravel())
     gmsh.model.mesh.addElementsByType(surface, 2, [], (triangles + 1).ravel())
-    for key, value in (("Mesh.MeshSizeMin", size), ("Mesh.MeshSizeMax", size),
-                       ("Mesh.Algorithm", 8), ("Mesh.RecombinationAlgorithm", 3),
+    coarse = 2.0 * size if split else size
+    for key, value in (("Mesh.MeshSizeMin", coarse), ("Mesh.MeshSizeMax", coarse),
+                       ("Mesh.Algorithm", 8), ("Mesh.RecombinationAlgorithm", 1 if split else 3),
+                       ("Mesh.SubdivisionAlgorithm", 1 if split else 0),
                        ("Mesh.MeshSizeFromCurvature", 0), ("Mesh.SecondOrderLinear", 1)):
         gmsh.option.setNumber(key, value)
     try:
@@ -55,7 +122,7 @@ def remesh(gmsh: Any, path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
                         f"{error}; a self-intersecting or non-manifold surface cannot be, and a size far "
                         "from the triangles' may need changing") from None
     x, conn, _, _ = extract(gmsh, f"surface file '{path}'")
-    return onto_surface(points, triangles, x), conn
+    return untangled(onto_surface(points, triangles, x), conn, lambda nodes: onto_surface(points, triangles, nodes)), conn
 
 
 def clean_facets(points: np.ndarray, triangles: np.ndarray, path: Path) -> np.ndarray:

@@ -439,6 +439,27 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
         build_model(parse_deck(text.replace('field = "fibre"', 'field = "fibres"')), mesh)
 
 
+def test_a_fibre_direction_along_the_shell_normal_is_refused_with_where():
+    """Fixed axes whose direction is the plate's normal gave every point the element's own
+    first direction, silently: refused, naming the key, the points and elements and a
+    place. A direction 30 degrees off the normal is projected on the plate as before."""
+    from shellsim.deck import parse_deck
+    from shellsim.model import build_model
+
+    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 2, width = 1 }")
+    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+                        'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\n'
+                        'axes = { kind = "fixed", direction = DIRECTION }')
+    deck = parse_deck(text.replace("DIRECTION", "[0.0, 0.0, 2.0]"))
+    with pytest.raises(MeshError, match=r"material.axes.direction = \(0, 0, 2\) lies along the shell's normal at "
+                                        r"\d+ of \d+ points, in elements 1, 2 \(element 1 at \(0.5, 0.5, 0\)\): "
+                                        "material axis 1 is its projection on the shell"):
+        build_model(deck, build_mesh(deck))
+    tilted = parse_deck(text.replace("DIRECTION", f"[{math.sin(math.radians(30))}, 0.0, {math.cos(math.radians(30))}]"))
+    axes = build_model(tilted, build_mesh(tilted)).material.axes0
+    np.testing.assert_allclose(axes[..., 0, :], np.broadcast_to([1.0, 0.0, 0.0], axes[..., 0, :].shape), atol=1e-12)
+
+
 def test_facets_segmentation_leaves_are_cleaned_and_a_non_manifold_edge_is_named(tmp_path):
     """A cylinder STL with what segmentation leaves in (a facet with a corner twice, one
     collapsed to a point, repeats of five facets) is remeshed as the clean file is (gmsh

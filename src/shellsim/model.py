@@ -15,7 +15,7 @@ import numpy as np
 from .bundles import Body, Constraints, Curves, Material, Model, Prescribed, Rule, Shape, slots_by_node
 from .curve_tables import EXTRAPOLATION, INTERPOLATION
 from .deck import Deck
-from .errors import MeshError
+from .errors import MeshError, id_list, place
 from .element.frames import initial_fibre_frame
 from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
@@ -136,10 +136,38 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     turns = np.zeros(len(tz)) if axes is None else axes.angles(tz)
     for k, t in enumerate(tz):
         position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)
-        frames = lamina_axes(jac, jac[..., 0] if axes is None else axes.preferred(position, mesh.cell_vectors))
+        preferred = jac[..., 0] if axes is None else axes.preferred(position, mesh.cell_vectors)
+        if axes is not None and not axes.MAY_MEET_NORMAL:
+            _refuse_along_normal(axes, jac, preferred, mesh.x[mesh.conn[:, 8]])
+        frames = lamina_axes(jac, preferred)
         a1 = np.cos(turns[k]) * frames[..., 0, :] + np.sin(turns[k]) * frames[..., 1, :]
         out[:, :, k] = np.stack([a1, np.cross(frames[..., 2, :], a1), frames[..., 2, :]], axis=-2)
     return out
+
+
+#: The sine of the angle between a given fibre direction and the lamina normal below which
+#: the direction is taken to lie along the normal (about 0.6 degrees): its projection on
+#: the lamina, axis 1, is then set by round-off.
+ALONG_NORMAL = 1e-2
+
+
+def _refuse_along_normal(axes, jac: np.ndarray, preferred: np.ndarray, centres: np.ndarray) -> None:
+    """Raise MeshError where ``preferred`` (ne, q, 3), a direction the deck or the mesh
+    gives, lies along the lamina normal of ``jac`` (ne, q, 3, 3): naming the key, the
+    count of points and elements and the first element's place (``centres`` (ne, 3))."""
+    normal = np.cross(jac[..., 0], jac[..., 1])
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    across = np.linalg.norm(np.cross(preferred, normal), axis=-1) / np.linalg.norm(preferred, axis=-1)
+    along = across < ALONG_NORMAL
+    if not along.any():
+        return
+    elements = np.flatnonzero(along.any(axis=1))
+    key = (f"material.axes.direction = {place(axes.direction)}" if axes.kind == "fixed"
+           else f"material.axes.field = '{axes.field}'")
+    raise MeshError(f"{key} lies along the shell's normal at {int(along.sum())} of {along.size} points, in "
+                    f"elements {id_list(elements + 1)} (element {elements[0] + 1} at "
+                    f"{place(centres[elements[0]])}): material axis 1 is its projection on the shell, "
+                    "which is not defined there; give a direction in the shell's plane")
 
 
 def lamina_axes(jac: np.ndarray, preferred: np.ndarray) -> np.ndarray:

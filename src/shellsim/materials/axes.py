@@ -26,6 +26,10 @@ class TurnedAxes(Section):
     lamina; ``cell_vectors`` are the mesh's per-element vectors by name."""
 
     angle_deg: Union[Angle, Annotated[list[Angle], Field(min_length=2)]] = 0.0
+    #: Whether the preferred direction may lie along the lamina normal, axis 1 then
+    #: falling back to the element's own first direction: a rule about an axis meets it on
+    #: the axis (a tube's cap); a direction the deck or the mesh gives never should.
+    MAY_MEET_NORMAL: ClassVar[bool] = True
 
     def angles(self, depths: np.ndarray) -> np.ndarray:
         """The angle (radians) at each thickness coordinate of ``depths`` (nt,), -1 the
@@ -56,6 +60,8 @@ class CylindricalAxes(TurnedAxes):
 
 class FixedAxes(TurnedAxes):
     """Material axis 1 along ``direction`` projected on the lamina; 3 is the lamina normal."""
+
+    MAY_MEET_NORMAL: ClassVar[bool] = False
 
     kind: Literal["fixed"]
     direction: Vec3
@@ -101,6 +107,8 @@ class CentrelineAxes(TurnedAxes):
 class MeshAxes(TurnedAxes):
     """Material axis 1 along the mesh file's per-element vectors ``field`` (cell data of 3
     components), projected on the lamina; 3 is the lamina normal."""
+
+    MAY_MEET_NORMAL: ClassVar[bool] = False
 
     kind: Literal["mesh"]
     field: Name

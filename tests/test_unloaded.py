@@ -118,3 +118,28 @@ def test_a_tethered_tube_unloads_to_its_exact_shorter_and_narrower_shape(tethere
     assert inner == pytest.approx(R_i, rel=5e-3) and thickness == pytest.approx(H, rel=5e-3)
     at = run.times.index(pytest.approx(0.14, abs=1e-12))
     assert run.history["inner_radius"][at] == pytest.approx(INNER, rel=1e-4)
+
+
+def test_an_unloaded_shape_not_found_leaves_its_record_not_an_earlier_run_s(tmp_path):
+    """An imaged tube allowed one iteration to a tolerance it cannot meet in one, run into
+    a folder an earlier run wrote: the command fails naming the iterations, and the folder
+    holds the new deck and a summary.json saying 'not converged' and why, with the earlier
+    run's history gone (it was taken for this run's)."""
+    import json
+
+    from typer.testing import CliRunner
+
+    from shellsim.cli import app
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "history.csv").write_text("time\n0\n")
+    (out / "summary.json").write_text('{"status": "completed"}')
+    deck = tmp_path / "imaged.toml"
+    deck.write_text(TEST9.read_text().replace(
+        "[output]\n", "[solver.imaged]\nat = 0.14\ntolerance = 1e-9\niterations = 1\n\n[output]\n", 1))
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(out), "--quiet"])
+    assert result.exit_code != 0 and "not found in solver.imaged.iterations = 1" in " ".join(result.output.split())
+    record = json.loads((out / "summary.json").read_text())
+    assert record["status"] == "not converged" and "solver.imaged.iterations = 1" in record["message"]
+    assert (out / "deck.toml").exists() and not (out / "history.csv").exists()

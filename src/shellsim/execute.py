@@ -102,12 +102,18 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     from .output.folder import claimed, clear_earlier_run, write_atomically
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
-    from .output.summary import summary, write_json
+    from .output.summary import summary, unstarted, write_json
     from .plan import plan
     from .solver.run import output_times
 
     with claimed(folder):  # before anything is written; another run's files stay as they are
-        current = built_run(scene, deck_path.parent, announce)
+        try:
+            current = built_run(scene, deck_path.parent, announce)
+        except NumericalError as error:  # the unloaded shape not found: the folder says so, not an earlier run
+            clear_earlier_run(folder, _run_files())
+            write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+            write_json(unstarted(scene, deck_path, str(error)), folder / "summary.json")
+            raise
         kept_samples = kept_frames = None
         if checkpoint is None:
             clear_earlier_run(folder, _run_files())

@@ -88,6 +88,13 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
     }
 
 
+def unstarted(scene, deck_path: Path, message: str) -> dict:
+    """The record of a run that failed before its first step (an imaged scene whose
+    unloaded shape was not found): what was run, its status and why."""
+    return {"deck": str(deck_path), "title": scene.meta.title, "version": __version__, "status": "not converged",
+            "method": scene.solver.method, "message": message, "steps": 0, "reference": []}
+
+
 def static_record(run: Run) -> dict:
     """A static solve's load steps: how many, the Newton iterations, tangents formed and
     cut-backs over them, the largest relative residual a step ended with, each step, and

@@ -156,6 +156,7 @@ class NewtonSolver:
         known = eq.prescribed_increments(t)
         pending = known  # the prescribed moves, made with the first correction
         first_energy, previous, before, tangents, fresh = None, np.inf, None, 0, False
+        predicted = np.inf  # how far the first correction moved the nodes (JUMP's measure)
         for iteration in range(settings.max_iterations + 1):
             residual = self.free_residual()
             scale = eq.force_scale()

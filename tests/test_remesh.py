@@ -107,12 +107,16 @@ def test_the_shipped_carotid_meshes_at_a_tenth_of_its_radius():
 def test_a_size_in_the_wrong_units_is_refused_before_meshing_with_a_size_to_use(tmp_path):
     """A cylinder in metres (R = 1, L = 3) with element_size = 1e-5 (a size meant in other
     units) would be about 2.45e11 elements: refused at once, naming the key, the file, the
-    estimate and a size that gives 10,000 elements."""
+    estimate and a size that gives 10,000 elements; 3000 (mm meant) is larger than the
+    whole surface, and refused so."""
     stl = cylinder_stl(tmp_path / "cylinder.stl", 1.0, 3.0, around=32, along=8)
     with pytest.raises(MeshError, match=r"geometry.element_size = 1e-05 would remesh surface file '.*cylinder.stl' "
                                         r"\(area 18.8., 3 across\) into about 2.4.e\+11 elements, more than 1,000,000: "
                                         r"is the size in the surface's units\? About 0.049. gives 10,000"):
         build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 1e-5')
+    with pytest.raises(MeshError, match=r"geometry.element_size = 3000 is larger than surface file '.*cylinder.stl' "
+                                        r"\(3 across\): is the size in the surface's units\?"):
+        build(f'builder = "file"\npath = "{stl.as_posix()}"\nelement_size = 3000.0')
 
 
 @pytest.mark.parametrize(("stop", "code", "said"), [(signal.SIGINT, 130, "interrupted"),

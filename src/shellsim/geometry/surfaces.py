@@ -52,17 +52,21 @@ ATTEMPTS = tuple((False, n) for n in NUDGES) + tuple((True, n) for n in NUDGES)
 def remesh(path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     """Quad9 nodes (n, 3) and connectivity (ne, 9) of the surface in ``path`` remeshed
     with elements of about ``size``, by gmsh in a child process (a stop ends it at once).
-    Raises MeshError for a surface that cannot be remeshed, or whose area at ``size``
-    would make more than MOST_ELEMENTS elements."""
+    Raises MeshError for a surface that cannot be remeshed, one smaller than ``size``, or
+    one whose area at ``size`` would make more than MOST_ELEMENTS elements (a size in
+    other units than the surface's)."""
     points, triangles = read_triangles(path)
     triangles = clean_facets(points, triangles, path)
     area = float(np.linalg.norm(np.cross(points[triangles[:, 1]] - points[triangles[:, 0]],
                                          points[triangles[:, 2]] - points[triangles[:, 0]]), axis=1).sum() / 2)
-    expected = ELEMENTS_PER_SQUARE * area / size**2
+    expected, across = ELEMENTS_PER_SQUARE * area / size**2, float(np.ptp(points, axis=0).max())
+    if size > across:
+        raise MeshError(f"geometry.element_size = {size:g} is larger than surface file '{path}' ({across:.4g} "
+                        "across): is the size in the surface's units?")
     if expected > MOST_ELEMENTS:
         suggested = np.sqrt(ELEMENTS_PER_SQUARE * area / SUGGESTED_ELEMENTS)
         raise MeshError(f"geometry.element_size = {size:g} would remesh surface file '{path}' (area {area:.4g}, "
-                        f"{np.ptp(points, axis=0).max():.4g} across) into about {expected:.3g} elements, more than "
+                        f"{across:.4g} across) into about {expected:.3g} elements, more than "
                         f"{MOST_ELEMENTS:,}: is the size in the surface's units? About {suggested:.3g} gives "
                         f"{SUGGESTED_ELEMENTS:,}")
     from .child import in_child

@@ -162,6 +162,7 @@ def mesh(
 
     scene = load_deck(deck)
     folder = output_folder(out_dir)
+    err.print(f"meshing {escape(str(deck))}", highlight=False)
     built = build_mesh(scene, deck.parent)
     write_mesh_vtu(built, folder / "mesh.vtu")
     written = [folder / "mesh.vtu"]

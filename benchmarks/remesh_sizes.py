@@ -18,12 +18,12 @@ import time
 from pathlib import Path
 from unittest import mock
 
-import meshio
 import numpy as np
 
 from shellsim.deck import parse_deck
 from shellsim.errors import ShellsimError
 from shellsim.geometry import build_mesh
+from shellsim.verify.surfaces import tube_facets, write_facets
 
 ROOT = Path(__file__).resolve().parents[1]
 DIVISORS = (4, 5, 6, 7, 8, 9, 10)
@@ -50,20 +50,6 @@ end_time = 1.0
 """
 
 
-def tube_stl(path: Path, inlet: float, outlet: float, length: float, around: int, along: int) -> Path:
-    """An open tube about z, its radius going linearly from ``inlet`` to ``outlet`` over
-    ``length``, as 2 x around x along facets."""
-    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
-    z = np.linspace(0.0, length, along + 1)
-    radius = inlet + (outlet - inlet) * z / length
-    points = np.array([[r * np.cos(p), r * np.sin(p), h] for r, h in zip(radius, z) for p in phi])
-    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
-    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
-    triangles = np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
-    meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
-    return path
-
-
 def attempt(path: Path, size: float) -> str:
     """A table cell: elements, longest side over the size and seconds, or why it failed."""
     start = time.perf_counter()
@@ -86,12 +72,12 @@ def as_before() -> Iterator[None]:
 
 def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
-        surfaces = {
-            "cylinder R 1, 32 x 8 facets": (tube_stl(Path(folder) / "coarse.stl", 1.0, 1.0, 8.0, 32, 8), 1.0),
-            "cylinder R 1, 128 x 48 facets": (tube_stl(Path(folder) / "fine.stl", 1.0, 1.0, 3.0, 128, 48), 1.0),
-            "tapered tube R 1 to 0.6, 128 x 128": (tube_stl(Path(folder) / "taper.stl", 1.0, 0.6, 8.0, 128, 128), 0.8),
-            "shipped carotid (R about 4 mm)": (ROOT / "decks" / "tissue" / "carotid_segment.stl", 0.004),
-        }
+        tubes = {"cylinder R 1, 32 x 8 facets": ("coarse", (1.0, 1.0, 8.0, 32, 8), 1.0),
+                 "cylinder R 1, 128 x 48 facets": ("fine", (1.0, 1.0, 3.0, 128, 48), 1.0),
+                 "tapered tube R 1 to 0.6, 128 x 128": ("taper", (1.0, 0.6, 8.0, 128, 128), 0.8)}
+        surfaces = {name: (write_facets(Path(folder) / f"{stem}.stl", *tube_facets(*shape)), radius)
+                    for name, (stem, shape, radius) in tubes.items()}
+        surfaces["shipped carotid (R about 4 mm)"] = (ROOT / "decks" / "tissue" / "carotid_segment.stl", 0.004)
         print("| surface | remesher | " + " | ".join(f"R/{d}" for d in DIVISORS) + " |")
         print("|---|---|" + "---|" * len(DIVISORS))
         for name, (path, radius) in surfaces.items():

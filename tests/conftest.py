@@ -5,7 +5,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -179,13 +178,6 @@ def scene():
 
 def cylinder_stl(path: Path, radius: float, length: float, around: int = 128, along: int = 48) -> Path:
     """An open cylinder about z, z in [0, length], as 2 x around x along facets."""
-    import meshio
+    from shellsim.verify.surfaces import tube_facets, write_facets
 
-    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
-    z = np.linspace(0.0, length, along + 1)
-    points = np.array([[radius * np.cos(p), radius * np.sin(p), h] for h in z for p in phi])
-    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
-    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
-    triangles = np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
-    meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
-    return path
+    return write_facets(path, *tube_facets(radius, radius, length, around, along))

@@ -6,7 +6,6 @@ MeshError, and remeshed or refused the same way."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 from hypothesis import HealthCheck, given, settings
@@ -15,6 +14,7 @@ from hypothesis import strategies as st
 from shellsim.deck.curves import read_table
 from shellsim.errors import MeshError
 from shellsim.geometry.surfaces import clean_facets, remesh
+from shellsim.verify.surfaces import tube_facets, write_facets
 
 #: Ordered, distinct times and finite values, as a waveform table holds them.
 TABLES = st.lists(st.tuples(st.floats(-1e6, 1e6, allow_nan=False), st.floats(-1e6, 1e6, allow_nan=False)),
@@ -59,15 +59,6 @@ def test_any_other_file_is_read_or_refused_with_a_value_error_naming_it(tmp_path
         assert len(t) == len(value) >= 1 and np.all(np.diff(t) > 0) and np.all(np.isfinite(t + value))
 
 
-def _cylinder(around: int = 16, along: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """An open cylinder (R = 1, L = 2) as points (n, 3) and facets (m, 3)."""
-    phi = np.linspace(0.0, 2 * np.pi, around, endpoint=False)
-    points = np.array([[np.cos(p), np.sin(p), z] for z in np.linspace(0.0, 2.0, along + 1) for p in phi])
-    a = (np.arange(along)[:, None] * around + np.arange(around)[None]).ravel()
-    b = (np.arange(along)[:, None] * around + (np.arange(around)[None] + 1) % around).ravel()
-    return points, np.concatenate([np.column_stack([a, b, b + around]), np.column_stack([a, b + around, a + around])])
-
-
 #: What segmentation leaves in a surface: (kind, which facet or point, the other).
 DEFECTS = st.lists(st.tuples(st.sampled_from(["repeat", "corner twice", "to a point", "fin", "merge"]),
                              st.integers(0, 127), st.integers(0, 79)), max_size=6)
@@ -75,7 +66,7 @@ DEFECTS = st.lists(st.tuples(st.sampled_from(["repeat", "corner twice", "to a po
 
 def _damaged(defects) -> tuple[np.ndarray, np.ndarray, bool]:
     """The cylinder with ``defects``; whether a fin (an edge of three facets) is among them."""
-    points, triangles = _cylinder()
+    points, triangles = tube_facets(1.0, 1.0, 2.0, 16, 4)
     extra, finned = [], False
     for kind, facet, point in defects:
         a, b, c = triangles[facet]
@@ -95,16 +86,6 @@ def _damaged(defects) -> tuple[np.ndarray, np.ndarray, bool]:
     return points, np.vstack([triangles, *(np.array([row]) for row in extra)]), finned
 
 
-def _written(tmp_path: Path, points: np.ndarray, triangles: np.ndarray) -> Path:
-    """The surface as an STL file (each facet's corners listed anew, as STL does)."""
-    import meshio
-
-    path = tmp_path / "damaged.stl"
-    with np.errstate(invalid="ignore"):  # meshio divides by the collapsed facets' zero normals
-        meshio.write(path, meshio.Mesh(points, [("triangle", triangles)]))
-    return path
-
-
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(defects=DEFECTS)
 def test_segmentation_defects_are_cleaned_or_a_non_manifold_edge_is_named(tmp_path, defects):
@@ -114,7 +95,7 @@ def test_segmentation_defects_are_cleaned_or_a_non_manifold_edge_is_named(tmp_pa
     where."""
     from shellsim.mesh_reading import read_triangles
 
-    path = _written(tmp_path, *_damaged(defects)[:2])
+    path = write_facets(tmp_path / "damaged.stl", *_damaged(defects)[:2])
     points, triangles = read_triangles(path)
     finned = _damaged(defects)[2]
     try:
@@ -133,7 +114,7 @@ def test_segmentation_defects_are_cleaned_or_a_non_manifold_edge_is_named(tmp_pa
 def test_a_damaged_surface_is_remeshed_or_refused_with_a_mesh_error(tmp_path, defects, size):
     """The damaged cylinder through the whole remesher (gmsh in its child process): quad9
     elements, or a MeshError naming the file; never a traceback or a hang."""
-    path = _written(tmp_path, *_damaged(defects)[:2])
+    path = write_facets(tmp_path / "damaged.stl", *_damaged(defects)[:2])
     try:
         x, conn = remesh(path, size)
     except MeshError as error:

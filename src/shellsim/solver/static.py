@@ -172,8 +172,9 @@ class NewtonSolver:
                 ran_away = scale > RUNAWAY * start_scale
                 if not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
                     self.held_apart(t)
-                    if self._moved() > JUMP * predicted:
-                        self.stability.jumped(self.eq.converged.t, self.run.load_time, t, self._moved() / predicted)
+                    moved = self._moved()
+                    if moved > JUMP * predicted:
+                        self.stability.jumped(self.eq.converged.t, self.run.load_time, t, moved / predicted)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
                 raise NotConverged(f"{iteration} iterations left a residual of {norm / max(scale, 1e-300):.3g} "

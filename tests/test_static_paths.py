@@ -117,6 +117,16 @@ def test_a_straight_strip_past_its_euler_loads_reports_each_bifurcation(control)
         assert event["negative_pivots_to"] == pivots
 
 
+def test_stability_checks_can_be_left_out_of_load_control():
+    """check_stability = false: the strip past its Euler loads reports nothing, and its
+    load steps form no tangent beyond the first step's."""
+    deck = parse_deck(STRIP.replace("LOAD", repr(10.5 * EULER)).replace('control = "CONTROL"',
+                                                                        'control = "load", check_stability = false'))
+    run = run_deck(deck)
+    assert run.status == "completed" and run.stability.events() == []
+    assert len(run.stability.observations) == 1  # the start's, which the first step's Newton uses
+
+
 HELD_RAMP = """
 [curves.ramp]
 t = [0.0, 0.5, 0.7, 0.8]

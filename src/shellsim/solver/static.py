@@ -2,9 +2,10 @@
 pseudo-time runs from 0 to the end time, the loads follow their curves in it, and each
 step solves f_int(u) = f_ext(t) with the tangent of :mod:`.equilibrium`. The signs of the
 pivots of a tangent formed at a converged state, with its own load, tell where the path
-loses stability (:mod:`.stability`): load control forms one wherever the load time has
-moved on by a load step of ``increments`` since the last, and at the end, and modified
-Newton goes on with it; arc length forms one at every step's start anyway. The works
+loses stability (:mod:`.stability`): load control forms one at the start, wherever the
+load time has moved on by a load step of ``increments`` since the last, and at the end
+(unless ``check_stability`` is off), and modified Newton goes on with it; arc length forms
+one at every step's start anyway. The works
 between converged states are the run's energies (:mod:`.static_work`).
 
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
@@ -312,7 +313,8 @@ def solve_static(run: Run, listener: Listener | None = None, until: float | None
             follow_path(run, newton, listener)
         else:
             _load_steps(run, newton, listener, until or run.deck.solver.end_time)
-        newton.observe()
+        if run.deck.solver.static.check_stability:
+            newton.observe()
     return run
 
 
@@ -329,7 +331,8 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
             step, length = newton.reach(landing, length)
             sim.state.t = step.t
             newton.commit(step)
-            if step.t >= observed + largest * (1.0 - 1e-9) and step.t < end * (1.0 - 1e-12):
+            if (run.deck.solver.static.check_stability and step.t >= observed + largest * (1.0 - 1e-9)
+                    and step.t < end * (1.0 - 1e-12)):
                 newton.observe()  # the end's is the run's last
                 observed = step.t
             _record(run, listener)

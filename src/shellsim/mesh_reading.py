@@ -94,3 +94,10 @@ def _vtp_cells(path: Path) -> tuple[np.ndarray, list[np.ndarray], set[str]]:
         else:
             kinds.add("polygon")
     return np.asarray(surface.points, dtype=float), blocks, kinds
+
+
+def facet_normals(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """(m, 3) each facet's normal, (b - a) x (c - a) of its corners on ``points`` (n, 3):
+    twice its area long, zero for a sliver."""
+    corners = points[triangles]
+    return np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])

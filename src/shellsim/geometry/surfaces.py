@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import MeshError, place
 from ..mesh import EDGES, NamedSet
-from ..mesh_reading import read_triangles
+from ..mesh_reading import facet_normals, read_triangles
 from .gmsh_extract import extract
 from .untangle import bad_elements, untangled
 
@@ -57,8 +57,7 @@ def remesh(path: Path, size: float) -> tuple[np.ndarray, np.ndarray]:
     other units than the surface's)."""
     points, triangles = read_triangles(path)
     triangles = clean_facets(points, triangles, path)
-    area = float(np.linalg.norm(np.cross(points[triangles[:, 1]] - points[triangles[:, 0]],
-                                         points[triangles[:, 2]] - points[triangles[:, 0]]), axis=1).sum() / 2)
+    area = float(np.linalg.norm(facet_normals(points, triangles), axis=1).sum() / 2)
     expected, across = ELEMENTS_PER_SQUARE * area / size**2, float(np.ptp(points, axis=0).max())
     if size > across:
         raise MeshError(f"geometry.element_size = {size:g} is larger than surface file '{path}' ({across:.4g} "
@@ -84,11 +83,11 @@ def _remesh_in_gmsh(points: np.ndarray, triangles: np.ndarray, size: float, path
     one with fewest, for the checks that follow to name."""
     from .session import gmsh_session
 
-    best, failure = None, None
+    best, failure, planes = None, None, FacetPlanes(points, triangles)
     for split, nudge in ATTEMPTS:
         try:
             with gmsh_session(name="surface") as gmsh:
-                x, conn = _quads(gmsh, points, triangles, size * nudge, path, split)
+                x, conn = _quads(gmsh, points, triangles, planes, size * nudge, path, split)
         except MeshError as error:
             failure = failure or error
             continue
@@ -102,11 +101,12 @@ def _remesh_in_gmsh(points: np.ndarray, triangles: np.ndarray, size: float, path
     return best[1], best[2]
 
 
-def _quads(gmsh: Any, points: np.ndarray, triangles: np.ndarray, size: float, path: Path,
+def _quads(gmsh: Any, points: np.ndarray, triangles: np.ndarray, planes: FacetPlanes, size: float, path: Path,
            split: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Quad9 nodes and connectivity of the facets remeshed in the gmsh session ``gmsh``;
-    ``split``: recombined at twice the size and every element split into four (gmsh's
-    subdivision), else recombined into full quads at the size."""
+    """Quad9 nodes and connectivity of the facets remeshed in the gmsh session ``gmsh``,
+    the nodes put on the facets' ``planes``; ``split``: recombined at twice the size and
+    every element split into four (gmsh's subdivision), else recombined into full quads
+    at the size."""
     surface = gmsh.model.addDiscreteEntity(2)
     gmsh.model.mesh.addNodes(2, surface, np.arange(1, len(points) + 1), points.ravel())
     gmsh.model.mesh.addElementsByType(surface, 2, [], (triangles + 1).ravel())
@@ -126,7 +126,7 @@ def _quads(gmsh: Any, points: np.ndarray, triangles: np.ndarray, size: float, pa
                         f"{error}; a self-intersecting or non-manifold surface cannot be, and a size far "
                         "from the triangles' may need changing") from None
     x, conn, _, _ = extract(gmsh, f"surface file '{path}'")
-    return untangled(onto_surface(points, triangles, x), conn, lambda nodes: onto_surface(points, triangles, nodes)), conn
+    return untangled(planes(x), conn, planes), conn
 
 
 def clean_facets(points: np.ndarray, triangles: np.ndarray, path: Path) -> np.ndarray:
@@ -148,18 +148,26 @@ def clean_facets(points: np.ndarray, triangles: np.ndarray, path: Path) -> np.nd
     return triangles
 
 
-def onto_surface(points: np.ndarray, triangles: np.ndarray, nodes: np.ndarray) -> np.ndarray:
-    """``nodes`` (k, 3) moved along the normal onto the plane of the triangle (of
-    ``points`` (n, 3), ``triangles`` (m, 3)) whose centre is nearest."""
-    from scipy.spatial import cKDTree
+class FacetPlanes:
+    """The planes of a surface's facets (``points`` (n, 3), ``triangles`` (m, 3)), looked
+    up by their centres, built once for every projection onto them."""
 
-    corners = points[triangles]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    area = np.linalg.norm(normals, axis=1)
-    corners, normals = corners[area > 0], normals[area > 0] / area[area > 0, None]  # slivers have no plane
-    _, nearest = cKDTree(corners.mean(axis=1)).query(nodes)
-    height = np.einsum("ki,ki->k", nodes - corners[nearest, 0], normals[nearest])
-    return nodes - height[:, None] * normals[nearest]
+    def __init__(self, points: np.ndarray, triangles: np.ndarray):
+        from scipy.spatial import cKDTree
+
+        normals = facet_normals(points, triangles)
+        area = np.linalg.norm(normals, axis=1)
+        has_plane = area > 0  # slivers have none
+        self.origins = points[triangles[has_plane, 0]]
+        self.normals = normals[has_plane] / area[has_plane, None]
+        self.tree = cKDTree(points[triangles[has_plane]].mean(axis=1))
+
+    def __call__(self, nodes: np.ndarray) -> np.ndarray:
+        """``nodes`` (k, 3) moved along the normal onto the plane of the facet whose centre
+        is nearest."""
+        _, nearest = self.tree.query(nodes)
+        height = np.einsum("ki,ki->k", nodes - self.origins[nearest], self.normals[nearest])
+        return nodes - height[:, None] * self.normals[nearest]
 
 
 def boundary_loops(x: np.ndarray, conn: np.ndarray, names: dict[str, tuple[float, float, float]],

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import MeshError
-from ..mesh_reading import read_triangles
+from ..mesh_reading import facet_normals, read_triangles
 from .contact_search import cell_faces, fill_grid, near_box
 
 #: Where a triangle's nearest point lies, the row of its pseudo-normal: the face, its
@@ -37,7 +37,7 @@ def read_tool(path: Path) -> tuple[np.ndarray, np.ndarray]:
     by more than two of them: it has no inside and outside."""
     points, triangles = read_triangles(path)
     corners = points[triangles]
-    normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normal = facet_normals(points, triangles)
     size = np.linalg.norm(normal, axis=1)
     kept = size > 1e-12 * size.max(initial=0.0)
     if not kept.any():

@@ -85,6 +85,16 @@ def _run_files() -> tuple[str, ...]:
             f"{CABLES}_{FRAMES_DIR}", *series)
 
 
+def _start_afresh(folder: Path, scene: Deck, deck_path: Path) -> None:
+    """``folder`` cleared of an earlier run's files, with the resolved deck of ``scene``
+    (read from ``deck_path``) written in it."""
+    from .deck.resolved import RESOLVED_NAME, resolved_text
+    from .output.folder import clear_earlier_run, write_atomically
+
+    clear_earlier_run(folder, _run_files())
+    write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+
+
 def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | None = None,
               announce: Callable[[str], None] = _silent, checkpoint: dict | None = None) -> tuple[Run, dict]:
     """Build and integrate ``scene`` (read from ``deck_path``) writing into ``folder``
@@ -97,9 +107,8 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
     'unstable', 'interrupted', 'output failed', 'refused': too long to run) and the
     summary's ``message`` why. ``announce`` hears the stages before the first step.
     Renders are left to the caller."""
-    from .deck.resolved import RESOLVED_NAME, resolved_text
     from .output.checkpoint import Checkpoints, restore
-    from .output.folder import claimed, clear_earlier_run, write_atomically
+    from .output.folder import claimed
     from .output.history import HistoryWriter
     from .output.series import FrameWriter, check_space
     from .output.summary import summary, unstarted, write_json
@@ -110,14 +119,12 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
         try:
             current = built_run(scene, deck_path.parent, announce)
         except NumericalError as error:  # the unloaded shape not found: the folder says so, not an earlier run
-            clear_earlier_run(folder, _run_files())
-            write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+            _start_afresh(folder, scene, deck_path)
             write_json(unstarted(scene, deck_path, str(error)), folder / "summary.json")
             raise
         kept_samples = kept_frames = None
         if checkpoint is None:
-            clear_earlier_run(folder, _run_files())
-            write_atomically(folder / RESOLVED_NAME, resolved_text(scene, deck_path, __version__))
+            _start_afresh(folder, scene, deck_path)
         else:
             restore(current, checkpoint)
             kept_samples, kept_frames = len(current.times), len(current.frame_times)

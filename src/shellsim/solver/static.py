@@ -5,8 +5,8 @@ pivots of a tangent formed at a converged state, with its own load, tell where t
 loses stability (:mod:`.stability`): load control forms one at the start, wherever the
 load time has moved on by a load step of ``increments`` since the last, and at the end
 (unless ``check_stability`` is off), and modified Newton goes on with it; arc length forms
-one at every step's start anyway. The works
-between converged states are the run's energies (:mod:`.static_work`).
+one at every step's start anyway. The works between converged states are the run's
+energies (:mod:`.static_work`).
 
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
 turns to no number, or whose tangent is singular) is taken again from the last converged
@@ -313,7 +313,7 @@ def solve_static(run: Run, listener: Listener | None = None, until: float | None
             follow_path(run, newton, listener)
         else:
             _load_steps(run, newton, listener, until or run.deck.solver.end_time)
-        if run.deck.solver.static.check_stability:
+        if newton.settings.check_stability:
             newton.observe()
     return run
 
@@ -321,7 +321,7 @@ def solve_static(run: Run, listener: Listener | None = None, until: float | None
 def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) -> None:
     """Load control to ``end``: steps that land on every output time before it."""
     sim = run.sim
-    largest = end / run.deck.solver.static.increments
+    largest = end / newton.settings.increments
     length = largest
     landings = output_times(run.deck)
     newton.observe()  # the first step's tangent, at the start
@@ -331,8 +331,7 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
             step, length = newton.reach(landing, length)
             sim.state.t = step.t
             newton.commit(step)
-            if (run.deck.solver.static.check_stability and step.t >= observed + largest * (1.0 - 1e-9)
-                    and step.t < end * (1.0 - 1e-12)):
+            if newton.settings.check_stability and observed + largest * (1.0 - 1e-9) <= step.t < end * (1.0 - 1e-12):
                 newton.observe()  # the end's is the run's last
                 observed = step.t
             _record(run, listener)

@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..mesh import EDGES
 
@@ -71,6 +72,10 @@ def untangled(x: np.ndarray, conn: np.ndarray, onto: Callable[[np.ndarray], np.n
     quads = conn[:, :4]
     pairs = np.concatenate([quads[:, [0, 1]], quads[:, [1, 2]], quads[:, [2, 3]], quads[:, [3, 0]]])
     pairs = np.unique(np.sort(pairs, axis=1), axis=0)
+    ends = np.concatenate([pairs, pairs[:, ::-1]])
+    # each corner's neighbours along element edges, each row summing to one (their mean)
+    degree = np.bincount(ends[:, 0], minlength=len(x))
+    mean = sp.csr_matrix((1.0 / degree[ends[:, 0]], (ends[:, 0], ends[:, 1])), shape=(len(x), len(x)))
     edges = conn[:, EDGES].reshape(-1, 3)
     key, counts = np.unique(np.sort(edges[:, [0, 2]], axis=1), axis=0, return_counts=True)
     boundary = np.unique(key[counts == 1])
@@ -79,11 +84,7 @@ def untangled(x: np.ndarray, conn: np.ndarray, onto: Callable[[np.ndarray], np.n
         near = np.unique(quads[bad])
         near = np.unique(quads[np.isin(quads, near).any(axis=1)])  # a ring around them
         near = np.setdiff1d(near, boundary)
-        total, count = np.zeros_like(x), np.zeros(len(x))
-        for a, b in (pairs[:, 0], pairs[:, 1]), (pairs[:, 1], pairs[:, 0]):
-            np.add.at(total, a, x[b])
-            np.add.at(count, a, 1.0)
-        x[near] = onto(total[near] / count[near, None])
+        x[near] = onto(mean[near] @ x)
         moved[near] = True
         bad = bad_elements(x, conn)
         if not len(bad):

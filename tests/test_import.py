@@ -442,6 +442,89 @@ def test_a_pipe_named_as_a_model_is_refused_not_read(tmp_path):
         read_foreign(tmp_path / "model.inp")
 
 
+def tethered_plate_feb(version: str, domain: str = "linear-truss", area: str = "0.5") -> str:
+    """:func:`tethered_plate_inp` as FEBio Studio saves it (format ``version``): the chord
+    a truss2 in a beam domain of ``domain`` type with cross_sectional_area ``area``, of a
+    'linear truss' material E = 1000; the force ramped by a load curve over a static step."""
+    four = version.startswith("4")
+
+    def node_set(name: str, ids: list[int]) -> str:
+        body = ",".join(map(str, ids)) if four else "".join(f'<n id="{i}"/>' for i in ids)
+        return f'<NodeSet name="{name}">{body}</NodeSet>'
+
+    def held(name: str, node_set: str, axes: str) -> str:
+        dofs = "".join(f"<{a}_dof>{int(a in axes)}</{a}_dof>" for a in "xyz") if four else f"<dofs>{','.join(axes)}</dofs>"
+        return f'<bc name="{name}" type="{"zero displacement" if four else "fix"}" node_set="{node_set}">{dofs}</bc>'
+
+    thickness = "<shell_thickness>0.1</shell_thickness>" if four else ""
+    data = ("" if four else '<MeshData><ElementData var="shell thickness" elem_set="Plate">'
+            '<e lid="1">0.1,0.1,0.1,0.1</e></ElementData></MeshData>')
+    force = ('<value lc="1">100,0,0</value>' if four else '<dof>x</dof><scale lc="1">100</scale>')
+    points = "<pt>0,0</pt><pt>1,1</pt>" if four else "<point>0,0</point><point>1,1</point>"
+    return f'''<?xml version="1.0" encoding="ISO-8859-1"?>
+<febio_spec version="{version}">
+  <Module type="solid"/>
+  <Control><analysis>STATIC</analysis><time_steps>4</time_steps><step_size>0.25</step_size></Control>
+  <Material>
+    <material id="1" name="Skin" type="isotropic elastic"><density>1e-9</density><E>1000000</E><v>0.3</v></material>
+    <material id="2" name="Cord" type="linear truss"><density>1.1e-9</density><E>1000</E><v>0.3</v></material>
+  </Material>
+  <Mesh>
+    <Nodes name="Object1"><node id="1">0,0,0</node><node id="2">1,0,0</node><node id="3">1,1,0</node>
+      <node id="4">0,1,0</node><node id="5">2,0,0</node></Nodes>
+    <Elements type="quad4" name="Plate"><elem id="1">1,2,3,4</elem></Elements>
+    <Elements type="truss2" name="Chord"><elem id="10">2,5</elem></Elements>
+    {node_set("Root", [1, 4])}{node_set("Pin", [2])}{node_set("End", [5])}
+  </Mesh>
+  <MeshDomains><ShellDomain name="Plate" mat="Skin">{thickness}</ShellDomain>
+    <BeamDomain name="Chord" mat="Cord" type="{domain}"><cross_sectional_area>{area}</cross_sectional_area></BeamDomain>
+  </MeshDomains>
+  {data}
+  <Boundary>{held("Root", "Root", "xyz")}
+    <bc name="RootShell" type="zero shell displacement" node_set="Root"><sx_dof>1</sx_dof><sy_dof>1</sy_dof><sz_dof>1</sz_dof></bc>
+    {held("Pin", "Pin", "xyz")}{held("Across", "End", "yz")}</Boundary>
+  <Loads><nodal_load name="Pull" type="{'nodal_force' if four else 'nodal_load'}" node_set="End">{force}</nodal_load></Loads>
+  <LoadData><load_controller id="1" name="Ramp" type="loadcurve">
+    <interpolate>LINEAR</interpolate><points>{points}</points></load_controller></LoadData>
+</febio_spec>
+'''
+
+
+@pytest.mark.parametrize("version", ["4.0", "3.0"])
+def test_febio_trusses_come_over_as_cables_that_stretch_as_their_law_says(tmp_path, version):
+    """A truss2 in a beam domain comes over as a cable, as Abaqus' T3D2 does: its own node,
+    its domain a line set, a [[cable]] table with the domain's cross_sectional_area and its
+    'linear truss' material's E and density; pulled by F = 100 with EA = 500 it stretches
+    by F / EA = 0.2 (the linear law's closed form). A domain with no area, or a truss
+    material with no 1D law, is listed with its line and its cables left out."""
+    path = tmp_path / "tethered.feb"
+    path.write_text(tethered_plate_feb(version))
+    done = import_model(path, tmp_path / "imported")
+    assert done.problems == [] and done.sets["Chord"] == "line"
+    mesh = read_mesh(done.mesh)
+    assert len(mesh.lines) == 1 and mesh.sets["Chord"].kind == "line"
+    np.testing.assert_allclose(mesh.x[mesh.lines[0]], [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
+    cable, = load_deck(done.deck).cable
+    assert (cable.set, cable.area, cable.density, cable.law.model, cable.law.E) == ("Chord", 0.5, 1.1e-9, "linear",
+                                                                                   1000.0)
+    assert tip_deflection_along(done, "End", "x") == pytest.approx(100.0 / 500.0, rel=1e-9)
+    without_area = read_foreign(_written(tmp_path / "no_area.feb", tethered_plate_feb(version, area="0")))
+    assert "cable" not in without_area.tables
+    assert any(re.search(r'<BeamDomain name="Chord"> \(no_area\.feb:\d+\): no positive cross_sectional_area', line)
+               for line in without_area.unmapped)
+    other_law = tethered_plate_feb(version).replace('type="linear truss"', 'type="Mooney-Rivlin"')
+    unmapped = read_foreign(_written(tmp_path / "law.feb", other_law))
+    assert "cable" not in unmapped.tables
+    assert any(re.search(r"<material name=\"Cord\"> \(law\.feb:\d+\): a truss of type 'Mooney-Rivlin'", line)
+               for line in unmapped.unmapped)
+
+
+def _written(path, text: str):
+    """``path`` with ``text`` written to it."""
+    path.write_text(text)
+    return path
+
+
 def tethered_plate_inp(line: str = "T3D2", section: str = "*Solid Section, elset=Chord, material=Cord\n0.5") -> str:
     """A clamped S4R plate 1 x 1 and a cable (a ``line`` element) of length 1 from its
     corner (2; pinned) along x to a node of its own (5), held across and pulled along

@@ -2,7 +2,8 @@
 
 Shell domains (quad4, quad8, quad9, tri3) become 9-node quads with their node sets,
 element sets and surfaces as named sets, shell thickness and material axes from the mesh
-data; the materials that map, zero and prescribed displacements, pressures, nodal forces,
+data; 2-node trusses in beam domains become cables (chordae), each domain a line set and
+a [[cable]] table; the materials that map, zero and prescribed displacements, pressures, nodal forces,
 contact pairs, load controllers and the first step's control become deck tables. What
 has no counterpart is listed with its line.
 
@@ -27,6 +28,8 @@ from .shell_mesh import ShellMesh, deck_name
 #: The attribute under which each XML element keeps its line.
 LINE = "{shellsim}line"
 SHELL_TYPES = {"tri3": 3, "quad4": 4, "quad8": 8, "quad9": 9}
+#: FEBio's 2-node truss, in a <BeamDomain> ("linear-truss", "elastic-truss"): a cable.
+TRUSS = "truss2"
 #: Sections the reader does not need: their content is not part of the mechanics.
 QUIET = {"Module", "Globals"}
 
@@ -82,6 +85,7 @@ class _Reader:
         self.used_curves: set[str] = set()
         self._mesh()
         self._material()
+        self._cables()
         steps = root.findall("Step/step")
         for step in steps[1:]:
             self.unmapped.append(f"{self.where(step)}: only the first step is brought over")
@@ -113,10 +117,12 @@ class _Reader:
             except (ValueError, AttributeError):
                 raise MeshError(f"{self.where(node)}: a node is 'x,y,z'; got '{node.text}'") from None
         shell_domains = {d.get("name"): d for d in self.root.findall("MeshDomains/ShellDomain")}
+        beam_domains = {d.get("name"): d for d in self.root.findall("MeshDomains/BeamDomain")}
         for domain in self.root.find("MeshDomains") or []:
-            if domain.tag != "ShellDomain":
-                self.unused_elements.append(f"{self.where(domain)}: a {domain.tag}; only shell domains come over")
-        elements, self.corner_labels = [], []
+            if domain.tag not in ("ShellDomain", "BeamDomain"):
+                self.unused_elements.append(f"{self.where(domain)}: a {domain.tag}; only shell domains and trusses "
+                                            "come over")
+        elements, lines, self.corner_labels = [], [], []
         for block in mesh.findall("Elements"):
             kind, name = block.get("type"), block.get("name")
             rows = block.findall("elem")
@@ -127,24 +133,37 @@ class _Reader:
                         raise MeshError(f"{self.where(e)}: a {kind} has {SHELL_TYPES[kind]} nodes; got '{e.text}'")
                     elements.append((e.get("id"), nodes, f"{self.path.name}:{e.get(LINE)}"))
                     self.corner_labels.append(nodes[:3 if len(nodes) == 3 else 4])
-            elif name not in shell_domains:
-                self.unused_elements.append(f"{self.where(block)}: {len(rows)} {kind} element(s) in no shell domain")
+            elif name in beam_domains and kind == TRUSS:
+                for e in rows:
+                    nodes = [n.strip() for n in (e.text or "").split(",")]
+                    if len(nodes) != 2:
+                        raise MeshError(f"{self.where(e)}: a {TRUSS} has 2 nodes; got '{e.text}'")
+                    lines.append((e.get("id"), nodes, f"{self.path.name}:{e.get(LINE)}"))
+            elif name not in shell_domains and name not in beam_domains:
+                self.unused_elements.append(f"{self.where(block)}: {len(rows)} {kind} element(s) in no shell or "
+                                            "beam domain")
             else:
-                self.unused_elements.append(f"{self.where(block)}: {kind} elements are not shells")
+                self.unused_elements.append(f"{self.where(block)}: {kind} elements are neither shells nor "
+                                            f"{TRUSS} trusses")
         self.unmapped.extend(self.unused_elements)
         if not elements:
             raise MeshError(f"model file '{self.path}' has no shell elements in a <ShellDomain> "
                             f"({', '.join(SHELL_TYPES)})")
         self.shells = ShellMesh(self.path, positions, elements)
+        if lines:
+            self.shells.add_lines(positions, lines)
         self.unmapped.extend(self.shells.notes)
         self.element_sets = {name: [e.get("id") for e in mesh.findall(f"Elements[@name='{name}']/elem")]
-                             for name in shell_domains}
+                             for name in shell_domains | beam_domains}
         for es in mesh.findall("ElementSet"):
             self.element_sets[es.get("name")] = _ids(es, "e")
         for name, labels in self.element_sets.items():
             elements = self.shells.elements_of(labels)
             if len(elements):
                 self.shells.add_set(("elset", name), name, self.shells.surface_set(elements))
+            cables = self.shells.line_set(labels)
+            if cables is not None:  # beside the shells' surface set, if the set has both
+                self.shells.add_set(("lines", name), name + ("_cables" if len(elements) else ""), cables)
         self.node_sets = {ns.get("name"): _ids(ns, "n") for ns in mesh.findall("NodeSet")}
         for name, labels in self.node_sets.items():
             nodes = self.shells.nodes_of(labels)
@@ -209,7 +228,7 @@ class _Reader:
 
     # -- material ---------------------------------------------------------------------------
     def _material(self) -> None:
-        materials = {m.get("name"): m for m in self.root.findall("Material/material")}
+        materials = self.materials = {m.get("name"): m for m in self.root.findall("Material/material")}
         materials |= {m.get("id"): m for m in self.root.findall("Material/material")}
         used = list(dict.fromkeys(d.get("mat") for d in self.root.findall("MeshDomains/ShellDomain")))
         if not used or used[0] not in materials:
@@ -252,6 +271,37 @@ class _Reader:
             self.unmapped.append(f"{self.where(m)}: no density; the deck's 1.0 is a placeholder (only an explicit "
                                  "run uses it)")
         self.tables["material"] = table | {"density": self.density if self.density is not None else 1.0}
+
+    def _cables(self) -> None:
+        """A [[cable]] table for each beam domain of trusses: its line set, the domain's
+        cross_sectional_area, its material's 1D law and density. A domain whose area or
+        material does not map is listed and its cables left out."""
+        cables = []
+        for domain in self.root.findall("MeshDomains/BeamDomain"):
+            lines = self.shells.set_of.get(("lines", domain.get("name")))
+            if lines is None:  # no trusses in it: its elements are listed already
+                continue
+            material = self.materials.get(domain.get("mat"))
+            if material is None:
+                raise MeshError(f"{self.where(domain)}: the material '{domain.get('mat')}' is not defined")
+            law = _truss_law(material)
+            area = float(domain.findtext("cross_sectional_area") or 0.0)
+            if law is None:
+                self.unmapped.append(f"{self.where(material)}: a truss of type '{material.get('type')}' has no "
+                                     f"shellsim 1D law ('linear truss', 'neo-Hookean' map); the cables of '{lines}' "
+                                     "are left out")
+            elif not area > 0.0:
+                self.unmapped.append(f"{self.where(domain)}: no positive cross_sectional_area; the cables of "
+                                     f"'{lines}' are left out")
+            else:
+                density = material.findtext("density")
+                if density is None:
+                    self.unmapped.append(f"{self.where(material)}: no density; the cables' 1.0 is a placeholder (only "
+                                         "an explicit run uses it)")
+                cables.append({"name": deck_name(f"{lines}_cable", "cable"), "set": lines, "area": area,
+                               "density": float(density) if density is not None else 1.0, "law": law})
+        if cables:
+            self.tables["cable"] = cables
 
     def _axes(self, material: ET.Element) -> dict:
         """Material axis 1: per element from the mesh data's mat_axis or fiber, or the
@@ -322,7 +372,8 @@ class _Reader:
                 raise MeshError(f"{self.where(bc)}: unknown node set '{node_set}'")
             if kind in ("zero displacement", "fix"):
                 dofs = {i + 1 for i, a in enumerate(AXES) if bc.findtext(f"{a}_dof", "0").strip() == "1"}
-                dofs |= {AXES.index(d.strip()) + 1 for d in (bc.findtext("dofs") or "").split(",") if d.strip() in AXES}
+                listed = [d.strip() for d in (bc.findtext("dofs") or "").split(",")]  # format 3.0: "x,y"
+                dofs |= {AXES.index(d) + 1 for d in listed if d in tuple(AXES)}
                 held[node_set] |= dofs
             elif kind == "zero shell displacement":  # the shell's back face held: its director kept
                 if all(bc.findtext(f"s{a}_dof", "0").strip() == "1" for a in AXES):
@@ -417,6 +468,18 @@ class _Reader:
             self.tables["solver"] = {"method": "explicit", "end_time": steps * size}
             self.unmapped.append(f"{self.where(control)}: {analysis.lower()} analysis: shellsim integrates it "
                                  "explicitly")
+
+
+def _truss_law(material: ET.Element) -> dict | None:
+    """The cable law of a truss's FEBio material: 'linear truss' (E) as the linear law, a
+    'neo-Hookean' (E, v) as the incompressible one of its shear modulus E / (2 (1 + v));
+    None for others."""
+    kind, E, v = material.get("type"), material.findtext("E"), material.findtext("v") or "0.5"
+    if kind == "linear truss" and E is not None:
+        return {"model": "linear", "E": float(E)}
+    if kind == "neo-Hookean" and E is not None:
+        return {"model": "neo_hookean", "mu": float(E) / (2.0 * (1.0 + float(v)))}
+    return None
 
 
 def _ids(element: ET.Element, child: str) -> list[str]:

@@ -11,11 +11,13 @@ import re
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from typer.testing import CliRunner
 
 from shellsim.cli import app
-from shellsim.deck import parse_deck
+from shellsim.deck import load_deck, parse_deck
 from shellsim.element.assembly import stiffness_product
+from shellsim.execute import built_run
 from shellsim.geometry import build_mesh
 from shellsim.model import build_model
 from shellsim.solver.equilibrium import Converged, Equilibrium
@@ -148,11 +150,6 @@ def test_every_element_entry_lands_where_a_plain_assembly_puts_it(deck):
     """The tangent's sparse pattern, worked out node by node, against scipy's assembly of
     the same element blocks entry by entry: a clamped panel with a symmetry plane (turned
     node frames), and a sheet with prescribed translations (known columns after the free)."""
-    import scipy.sparse as sp
-
-    from shellsim.deck import load_deck
-    from shellsim.execute import built_run
-
     run = panel_run(*PATHS["small strain, total"]) if deck == "panel" else built_run(load_deck(ROOT / deck), ROOT)
     eq = Equilibrium(run.sim)
     u, conn = eq.unknowns, run.sim.model.conn

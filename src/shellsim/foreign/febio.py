@@ -82,6 +82,8 @@ class _Reader:
                                    "Contact", "LoadData", "Step"):
                 self.unmapped.append(f"{self.where(section)}: not read by shellsim")
         self._curves()
+        #: the file's materials by name and by id
+        self.materials = {key: m for m in root.findall("Material/material") for key in (m.get("name"), m.get("id"))}
         self.used_curves: set[str] = set()
         self._mesh()
         self._material()
@@ -228,8 +230,7 @@ class _Reader:
 
     # -- material ---------------------------------------------------------------------------
     def _material(self) -> None:
-        materials = self.materials = {m.get("name"): m for m in self.root.findall("Material/material")}
-        materials |= {m.get("id"): m for m in self.root.findall("Material/material")}
+        materials = self.materials
         used = list(dict.fromkeys(d.get("mat") for d in self.root.findall("MeshDomains/ShellDomain")))
         if not used or used[0] not in materials:
             raise MeshError(f"model file '{self.path}': the shell domain's material '{used[0] if used else ''}' is "

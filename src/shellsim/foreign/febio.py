@@ -226,7 +226,7 @@ class _Reader:
             total, count = np.zeros(len(self.shells.x)), np.zeros(len(self.shells.x))
             np.add.at(total, self.shells.conn, per_element[:, None])
             np.add.at(count, self.shells.conn, 1.0)
-            self.shells.thickness = total / count
+            self.shells.thickness = total / np.maximum(count, 1.0)  # a cable's own node: 0
 
     # -- material ---------------------------------------------------------------------------
     def _material(self) -> None:

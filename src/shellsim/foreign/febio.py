@@ -3,9 +3,9 @@
 Shell domains (quad4, quad8, quad9, tri3) become 9-node quads with their node sets,
 element sets and surfaces as named sets, shell thickness and material axes from the mesh
 data; 2-node trusses in beam domains become cables (chordae), each domain a line set and
-a [[cable]] table; the materials that map, zero and prescribed displacements, pressures, nodal forces,
-contact pairs, load controllers and the first step's control become deck tables. What
-has no counterpart is listed with its line.
+a [[cable]] table; the materials that map, zero and prescribed displacements, pressures,
+nodal forces, contact pairs, load controllers and the first step's control become deck
+tables. What has no counterpart is listed with its line.
 
 Signs: a facet's normal follows its nodes by the right-hand rule, and a positive pressure
 pushes against it (FEBio's convention), on the mid-surface, as a shell's reference surface.

@@ -21,6 +21,7 @@ from ..curve_tables import factor
 from ..loads import LoadTangents
 from ..threads import over_threads
 from .simulation import Simulation
+from .tangent_pattern import tangent_pattern
 from .unknowns import SLOTS, unknowns
 
 #: Central-difference steps (the loads' tangents, the elements' check): a share of the mean
@@ -62,50 +63,13 @@ class Equilibrium:
         self._t = 0.0
         self._tangents = TypedCall(element_tangents)
         self._load_tangents = LoadTangents(model)
-        self._pattern()
+        #: where the element blocks go in the tangent
+        self.pattern = tangent_pattern(model.conn, self.unknowns)
+        self._frames()
 
-    def _pattern(self) -> None:
-        """The sparse structure of the tangent's free rows and all columns, and where each
-        element entry goes in it.
-
-        Worked out node by node, not entry by entry (sorting the 2,025 entries of each
-        element took a sixth of a small static solve): each column of a node holds the free
-        rows of the nodes it shares an element with, in those nodes' order, since the free
-        unknowns are numbered node by node (:func:`.unknowns.unknowns`)."""
-        u = self.unknowns
-        model = self.sim.model
-        conn, n = model.conn, model.n_nodes
-        free = (u.index >= 0) & (u.index < u.n_free)  # (n, 5)
-        free_rows = free.sum(axis=1)
-        first_row = np.where(free, u.index, u.n_free).min(axis=1)  # each node's first free unknown
-        # node pairs (column node, row node) that share an element, by column node, then row node
-        pair_keys, pair_of = np.unique(conn[:, None, :] * n + conn[:, :, None], return_inverse=True)
-        pair_of = pair_of.reshape(len(conn), 9, 9)  # (ne, row node, column node)
-        column_node, row_node = np.divmod(pair_keys, n)
-        pair_rows = free_rows[row_node]
-        pair_start = np.cumsum(pair_rows) - pair_rows  # where each pair's rows start in all pairs' rows
-        first_pair = np.searchsorted(column_node, np.arange(n)).clip(max=len(pair_keys) - 1)  # each node's
-        offset = pair_start - pair_start[first_pair[column_node]]  # the pair's rows' place in its columns
-        column_length = np.bincount(column_node, weights=pair_rows, minlength=n).astype(np.int64)
-        known = u.index >= 0  # the columns: every unknown, free or prescribed, by its number
-        node_of_column = np.empty(u.size, dtype=np.int64)
-        node_of_column[u.index[known]] = np.nonzero(known)[0]
-        lengths = column_length[node_of_column]
-        indptr = np.zeros(u.size + 1, dtype=np.int64)
-        np.cumsum(lengths, out=indptr[1:])
-        all_rows = np.repeat(first_row[row_node] - pair_start, pair_rows) + np.arange(pair_rows.sum())
-        within = np.arange(indptr[-1]) - np.repeat(indptr[:-1], lengths)
-        indices = all_rows[np.repeat(pair_start[first_pair[node_of_column]], lengths) + within]
-        self._csc = (indices.astype(np.int32), indptr.astype(np.int32), int(indptr[-1]))
-        # each element entry (e, row node, its slot, column node, its slot): its column's
-        # start, its row node's offset there, its row's rank among that node's
-        index = u.index[conn]  # (ne, 9, 5)
-        column_start = indptr[np.maximum(index, 0)]
-        rank = index - first_row[conn][:, :, None]
-        slot = column_start[:, None, None] + offset[pair_of][:, :, None, :, None] + rank[:, :, :, None, None]
-        used = ((index >= 0) & (index < u.n_free))[:, :, :, None, None] & known[conn][:, None, None]
-        self._entries = np.flatnonzero(used)
-        self._slot = slot.ravel()[self._entries]
+    def _frames(self) -> None:
+        """Each element's node frames, to turn its block into the unknowns' directions."""
+        u, model = self.unknowns, self.sim.model
         # each node's frame as a (5, 5) block: the translations turned, the rotations kept
         blocks = np.zeros((model.n_nodes, SLOTS, SLOTS))
         blocks[:, :3, :3] = u.frames
@@ -179,9 +143,7 @@ class Equilibrium:
             blocks = self._element_blocks
             k = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k.reshape(len(k), 9, SLOTS, 9, SLOTS), blocks,
                           optimize=True).reshape(k.shape)
-        indices, indptr, nnz = self._csc
-        data = np.bincount(self._slot, weights=k.ravel()[self._entries], minlength=nnz)
-        tangent = sp.csc_matrix((data, indices, indptr), shape=(self.unknowns.n_free, self.unknowns.size))
+        tangent = self.pattern.assemble(k)
         coupled = self._coupled()
         return tangent if coupled is None else (tangent - coupled).tocsc()
 

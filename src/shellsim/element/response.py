@@ -157,13 +157,13 @@ def group_response(steps, rule, material, group, points, scratch, count):
     tie_membrane(rule, points, scratch, nq, nt)
     tie_shear(rule, points, scratch, nq, nt)
     nb = rule.vol_basis.shape[1]
-    if nb:
-        project_volumetric(points.EPS, points.DV, rule.vol_basis, False, count, scratch)
+    if nb:  # the direction as a run-time boolean: a literal one would compile the projection twice
+        project_volumetric(points.EPS, points.DV, rule.vol_basis, np.bool_(False), count, scratch)
     # 3. stresses at the Gauss points
     _stresses(steps, rule, material, group, points, scratch)
     # 4. the effective stresses of the assumed strains
     if nb:
-        project_volumetric(points.SW, points.DV, rule.vol_basis, True, count, scratch)
+        project_volumetric(points.SW, points.DV, rule.vol_basis, np.bool_(True), count, scratch)
     membrane_tying_stresses(rule, points, scratch, nq, nt)
     shear_tying_stresses(rule, points, group.stress, scratch, nq, nt)
     # 5. nodal forces: the direct stresses at the Gauss points, the tied shears and

@@ -13,8 +13,8 @@ import pytest
 
 from shellsim.foreign import read_foreign
 
-from .test_febio_round_trip import (CURL, MIDDLE, NX, NY, PAPILLARY, axis_of, file_element_under, file_elements,
-                                    nearest, sheet_node, surface_z)
+from .test_febio_round_trip import (CURL, MIDDLE, NX, NY, PAPILLARY, assert_sheet_loads, axis_of, file_element_under,
+                                    file_elements, nearest, sheet_node, surface_z)
 
 #: The two shell sections' thicknesses: the quads', the triangles'.
 BELLY, EDGE = 0.4, 0.3
@@ -106,15 +106,9 @@ def test_an_abaqus_model_comes_back_whole(tmp_path):
     for i, value in LIFT.items():
         if i != NX // 2:
             assert field[found[sheet_node(i, NY) - 1]] == pytest.approx(value, rel=1e-12)
-    # the pressure on both sides of the surface, the nodal force, the amplitudes
-    pressures = [load for load in tables["load"] if load["type"] == "pressure"]
-    covered = np.concatenate([mesh.sets[load["set"]].elements for load in pressures])
-    assert sorted(covered) == list(range(len(mesh.conn))) and {load["curve"] for load in pressures} == {"Beat"}
-    by_value = {load["value"]: set(pieces[mesh.sets[load["set"]].elements] < 100) for load in pressures}
-    assert sorted(by_value) == [-0.01, 0.01] and sorted(map(tuple, by_value.values())) == [(False,), (True,)]
-    tug, = (load for load in tables["load"] if load["type"] == "point_force")
-    assert (tug["value"], tug["curve"]) == ([0.1, 0.0, 0.0], "Ramp")
-    assert mesh.x[mesh.sets[tug["set"]].nodes].tolist() == [[2.0, 3.0, surface_z(2.0).item()]]
+    # the pressure on both sides of the surface (SPOS on the quads, SNEG on the triangles),
+    # the nodal force, the amplitudes
+    assert_sheet_loads(mesh, tables["load"], pieces)
     assert tables["curves"]["Ramp"] == {"t": [0.0, 1.0], "value": [0.0, 1.0]}
     assert tables["curves"]["Beat"] | {"extrapolate": None} == {"t": [0.0, 0.5], "value": [0.0, 1.0],
                                                                 "interpolate": "smooth", "extrapolate": None}

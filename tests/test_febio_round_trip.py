@@ -143,6 +143,21 @@ def file_element_under(centre: np.ndarray) -> int:
     return 101 + 2 * i if centre[0] - i > centre[1] - j else 102 + 2 * i  # below or above the diagonal
 
 
+def assert_sheet_loads(mesh, loads: list[dict], pieces: np.ndarray) -> None:
+    """The sheet's loads as both round trips give them: a pressure of 0.01 on every element
+    on the curve 'Beat', pushing one way on the quads and the other on the triangles (whose
+    facets the files give the other way round), and a force of 0.1 along x on the top row's
+    middle node on 'Ramp'. ``pieces``: each mesh element's file element."""
+    pressures = [load for load in loads if load["type"] == "pressure"]
+    covered = np.concatenate([mesh.sets[load["set"]].elements for load in pressures])
+    assert sorted(covered) == list(range(len(mesh.conn))) and {load["curve"] for load in pressures} == {"Beat"}
+    by_value = {load["value"]: set(pieces[mesh.sets[load["set"]].elements] < 100) for load in pressures}
+    assert sorted(by_value) == [-0.01, 0.01] and sorted(map(tuple, by_value.values())) == [(False,), (True,)]
+    tug, = (load for load in loads if load["type"] == "point_force")
+    assert (tug["value"], tug["curve"]) == ([0.1, 0.0, 0.0], "Ramp")
+    assert mesh.x[mesh.sets[tug["set"]].nodes].tolist() == [[2.0, 3.0, surface_z(2.0).item()]]
+
+
 @pytest.mark.parametrize("version", ["4.0", "3.0"])
 def test_a_febio_model_comes_back_whole(tmp_path, version):
     path = tmp_path / "valve_patch.feb"
@@ -182,15 +197,7 @@ def test_a_febio_model_comes_back_whole(tmp_path, version):
     assert boundary["fixed", "Papillary"]["translations"] == ["x", "y"]
     assert boundary["prescribed", "Papillary"] == {"type": "prescribed", "set": "Papillary", "translation": "z",
                                                    "value": -0.5, "curve": "Ramp"}
-    pressures = [load for load in tables["load"] if load["type"] == "pressure"]
-    covered = np.concatenate([mesh.sets[load["set"]].elements for load in pressures])
-    assert sorted(covered) == list(range(len(mesh.conn))) and {load["curve"] for load in pressures} == {"Beat"}
-    # the triangles' facets given the other way round: their pressure pushes the other way
-    by_value = {load["value"]: set(pieces[mesh.sets[load["set"]].elements] < 100) for load in pressures}
-    assert sorted(by_value) == [-0.01, 0.01] and sorted(map(tuple, by_value.values())) == [(False,), (True,)]
-    tug, = (load for load in tables["load"] if load["type"] == "point_force")
-    assert (tug["value"], tug["curve"]) == ([0.1, 0.0, 0.0], "Ramp")
-    assert mesh.x[mesh.sets[tug["set"]].nodes].tolist() == [[2.0, 3.0, surface_z(2.0).item()]]
+    assert_sheet_loads(mesh, tables["load"], pieces)
     assert tables["curves"] == {"Ramp": {"t": [0.0, 1.0], "value": [0.0, 1.0]},
                                 "Beat": {"t": [0.0, 0.5, 1.0], "value": [0.0, 1.0, 1.0], "interpolate": "smooth"}}
     cable, = tables["cable"]

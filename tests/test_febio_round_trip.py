@@ -12,6 +12,8 @@ import pytest
 
 from shellsim.foreign import read_foreign
 
+from .test_import import feb_force, feb_held, feb_set
+
 #: The sheet: NX x NY unit squares over z = CURL x^2, quads below the top row, two
 #: triangles a square in it; a chord of two trusses from the top row's middle node.
 NX, NY, CURL = 4, 3, 0.1
@@ -60,14 +62,6 @@ def febio_model(version: str) -> str:
     nodes[middle_id], nodes[papillary_id] = MIDDLE, PAPILLARY
     top = sheet_node(NX // 2, NY)
 
-    def id_set(tag: str, name: str, ids: list[int], child: str) -> str:
-        body = ",".join(map(str, ids)) if four else "".join(f'<{child} id="{i}"/>' for i in ids)
-        return f'<{tag} name="{name}">{body}</{tag}>'
-
-    def held(name: str, node_set: str, axes: str) -> str:
-        dofs = "".join(f"<{a}_dof>{int(a in axes)}</{a}_dof>" for a in "xyz") if four else f"<dofs>{','.join(axes)}</dofs>"
-        return f'<bc name="{name}" type="{"zero displacement" if four else "fix"}" node_set="{node_set}">{dofs}</bc>'
-
     def element_data(kind: str, rows: str) -> str:
         return f'<ElementData {"type" if four else "var"}="{kind}" elem_set="Shells">{rows}</ElementData>'
 
@@ -86,9 +80,6 @@ def febio_model(version: str) -> str:
     prescribed = ('<bc name="Lift" type="prescribed displacement" node_set="Papillary"><dof>z</dof>'
                   '<value lc="1">-0.5</value><relative>0</relative></bc>' if four else
                   '<bc name="Lift" type="prescribe" node_set="Papillary"><dof>z</dof><scale lc="1">-0.5</scale></bc>')
-    force = ('<nodal_load name="Tug" type="nodal_force" node_set="TipNode"><value lc="1">0.1,0,0</value></nodal_load>'
-             if four else '<nodal_load name="Tug" type="nodal_load" node_set="TipNode"><dof>x</dof>'
-             '<scale lc="1">0.1</scale></nodal_load>')
     point = "pt" if four else "point"
     curves = "".join(
         f'<load_controller id="{i}" name="{name}" type="loadcurve"><interpolate>{how}</interpolate><points>'
@@ -108,21 +99,22 @@ def febio_model(version: str) -> str:
     <Nodes name="Object1">{"".join(f'<node id="{n}">{text(x)}</node>' for n, x in nodes.items())}</Nodes>
     {blocks}
     <Elements type="truss2" name="Chord"><elem id="201">{top},{middle_id}</elem><elem id="202">{middle_id},{papillary_id}</elem></Elements>
-    {id_set("NodeSet", "Root", [sheet_node(i, 0) for i in range(NX + 1)], "n")}
-    {id_set("NodeSet", "Papillary", [papillary_id], "n")}
-    {id_set("NodeSet", "TipNode", [top], "n")}
-    {id_set("ElementSet", "Centre", [2, 3], "e")}
-    {id_set("ElementSet", "Shells", shells, "e")}
+    {feb_set(version, "NodeSet", "Root", [sheet_node(i, 0) for i in range(NX + 1)], "n")}
+    {feb_set(version, "NodeSet", "Papillary", [papillary_id], "n")}
+    {feb_set(version, "NodeSet", "TipNode", [top], "n")}
+    {feb_set(version, "ElementSet", "Centre", [2, 3], "e")}
+    {feb_set(version, "ElementSet", "Shells", shells, "e")}
     <Surface name="Top">{facets}</Surface>
   </Mesh>
   <MeshDomains><ShellDomain name="Belly" mat="Leaflet"/><ShellDomain name="Edge" mat="Leaflet"/>
     <BeamDomain name="Chord" mat="Chorda" type="linear-truss"><cross_sectional_area>0.2</cross_sectional_area></BeamDomain>
   </MeshDomains>
   <MeshData>{element_data("mat_axis", axes)}{element_data("shell thickness", thickness)}</MeshData>
-  <Boundary>{held("Root", "Root", "xyz")}
+  <Boundary>{feb_held(version, "Root", "Root", "xyz")}
     <bc name="RootShell" type="zero shell displacement" node_set="Root"><sx_dof>1</sx_dof><sy_dof>1</sy_dof><sz_dof>1</sz_dof></bc>
-    {held("Guide", "Papillary", "xy")}{prescribed}</Boundary>
-  <Loads><surface_load type="pressure" surface="Top"><pressure lc="2">0.01</pressure></surface_load>{force}</Loads>
+    {feb_held(version, "Guide", "Papillary", "xy")}{prescribed}</Boundary>
+  <Loads><surface_load type="pressure" surface="Top"><pressure lc="2">0.01</pressure></surface_load>
+    {feb_force(version, "Tug", "TipNode", "x", 0.1)}</Loads>
   <LoadData>{curves}</LoadData>
   <Output><plotfile type="febio"><var type="displacement"/></plotfile></Output>
 </febio_spec>

@@ -282,7 +282,32 @@ def test_shellsim_import_writes_a_deck_that_checks(strip, tmp_path):
     assert again.exit_code == 2 and "exists" in again.output and (out / "deck.toml").read_text() == before
 
 
-def strip_feb(version: str = "4.0", pressure_facets: bool = False, reversed_elements: tuple = ()) -> str:
+def feb_set(version: str, tag: str, name: str, ids: list[int], child: str) -> str:
+    """A FEBio node or element set: its ids as a comma list (format 4.0) or as ``child``
+    elements (3.0)."""
+    body = ",".join(map(str, ids)) if version.startswith("4") else "".join(f'<{child} id="{i}"/>' for i in ids)
+    return f'<{tag} name="{name}">{body}</{tag}>'
+
+
+def feb_held(version: str, name: str, node_set: str, axes: str) -> str:
+    """A FEBio zero displacement of ``axes`` (e.g. "yz") on a node set, as either format writes it."""
+    if version.startswith("4"):
+        dofs = "".join(f"<{a}_dof>{int(a in axes)}</{a}_dof>" for a in "xyz")
+        return f'<bc name="{name}" type="zero displacement" node_set="{node_set}">{dofs}</bc>'
+    return f'<bc name="{name}" type="fix" node_set="{node_set}"><dofs>{",".join(axes)}</dofs></bc>'
+
+
+def feb_force(version: str, name: str, node_set: str, axis: str, value: float) -> str:
+    """A FEBio nodal force ``value`` along ``axis`` on a node set, on load curve 1."""
+    if version.startswith("4"):
+        vector = ",".join(repr(value if a == axis else 0.0) for a in "xyz")
+        return f'<nodal_load name="{name}" type="nodal_force" node_set="{node_set}"><value lc="1">{vector}</value></nodal_load>'
+    return (f'<nodal_load name="{name}" type="nodal_load" node_set="{node_set}"><dof>{axis}</dof>'
+            f'<scale lc="1">{value!r}</scale></nodal_load>')
+
+
+def strip_feb(version: str = "4.0", pressure_facets: bool = False, reversed_elements: tuple = (),
+              tip_force: float = -0.001) -> str:
     """The cantilever strip of :func:`strip_inp` as FEBio Studio saves it (format
     ``version``): a quad4 shell domain of thickness 0.1 (3.0: as element data), the root
     node set held (displacements and shell displacements), a nodal force on the tip nodes
@@ -297,16 +322,10 @@ def strip_feb(version: str = "4.0", pressure_facets: bool = False, reversed_elem
             n1 = 1 + i + j * (nx + 1)
             elements[1 + i + j * nx] = [n1, n1 + 1, n1 + nx + 2, n1 + nx + 1]
 
-    def id_set(tag: str, name: str, ids: list[int], child: str) -> str:
-        body = ",".join(map(str, ids)) if four else "".join(f'<{child} id="{i}"/>' for i in ids)
-        return f'<{tag} name="{name}">{body}</{tag}>'
-
     root = [n for n, x, _ in nodes if x == 0.0]
     tip = [n for n, x, _ in nodes if x == 10.0]
     facets = "".join(f'<quad4 id="{k}">{",".join(map(str, elements[k][::-1] if k in reversed_elements else elements[k]))}'
                      "</quad4>" for k in elements) if pressure_facets else ""
-    held = ("<x_dof>1</x_dof><y_dof>1</y_dof><z_dof>1</z_dof>" if four else "<dofs>x,y,z</dofs>")
-    force = ('<value lc="1">0,0,-0.001</value>' if four else '<dof>z</dof><scale lc="1">-0.001</scale>')
     thickness = ('<shell_thickness>0.1</shell_thickness>' if four else "")
     data = ("" if four else '<MeshData><ElementData var="shell thickness" elem_set="Strip">'
             + "".join(f'<e lid="{k}">0.1,0.1,0.1,0.1</e>' for k in elements) + "</ElementData></MeshData>")
@@ -321,17 +340,17 @@ def strip_feb(version: str = "4.0", pressure_facets: bool = False, reversed_elem
   <Mesh>
     <Nodes name="Object1">{"".join(f'<node id="{n}">{x},{y},0</node>' for n, x, y in nodes)}</Nodes>
     <Elements type="quad4" name="Strip">{"".join(f'<elem id="{k}">{",".join(map(str, v))}</elem>' for k, v in elements.items())}</Elements>
-    {id_set("NodeSet", "Root", root, "n")}
-    {id_set("NodeSet", "Tip", tip, "n")}
+    {feb_set(version, "NodeSet", "Root", root, "n")}
+    {feb_set(version, "NodeSet", "Tip", tip, "n")}
     <Surface name="Top">{facets}</Surface>
   </Mesh>
   <MeshDomains><ShellDomain name="Strip" mat="Steel">{thickness}</ShellDomain></MeshDomains>
   {data}
   <Boundary>
-    <bc name="Root" type="{'zero displacement' if four else 'fix'}" node_set="Root">{held}</bc>
+    {feb_held(version, "Root", "Root", "xyz")}
     <bc name="RootShell" type="zero shell displacement" node_set="Root"><sx_dof>1</sx_dof><sy_dof>1</sy_dof><sz_dof>1</sz_dof></bc>
   </Boundary>
-  <Loads><nodal_load name="Tip" type="{'nodal_force' if four else 'nodal_load'}" node_set="Tip">{force}</nodal_load>{pressure}</Loads>
+  <Loads>{feb_force(version, "Tip", "Tip", "z", tip_force)}{pressure}</Loads>
   <LoadData><load_controller id="1" name="Ramp" type="loadcurve">
     <interpolate>LINEAR</interpolate><points>{points}</points></load_controller></LoadData>
   <Output><plotfile type="febio"><var type="displacement"/></plotfile></Output>
@@ -360,8 +379,7 @@ def test_febio_pressure_pushes_against_each_facet_s_normal(tmp_path):
     the other way round): FEBio pushes against each facet's normal, 19 facets' along -z
     and one's along +z: the resultant along z is -2 (9.5 - 0.5)."""
     path = tmp_path / "plate.feb"
-    path.write_text(strip_feb(pressure_facets=True, reversed_elements=(3,)).replace('<value lc="1">0,0,-0.001</value>',
-                                                                                     '<value lc="1">0,0,0</value>'))
+    path.write_text(strip_feb(pressure_facets=True, reversed_elements=(3,), tip_force=0.0))
     model = read_foreign(path)
     tables = model.tables | {"geometry": {"builder": "file", "path": str(path)}, "solver": {"end_time": 1.0}}
     tables["load"] = [t for t in tables["load"] if t["type"] == "pressure"]
@@ -448,18 +466,9 @@ def tethered_plate_feb(version: str, domain: str = "linear-truss", area: str = "
     'linear truss' material E = 1000; the force ramped by a load curve over a static step."""
     four = version.startswith("4")
 
-    def node_set(name: str, ids: list[int]) -> str:
-        body = ",".join(map(str, ids)) if four else "".join(f'<n id="{i}"/>' for i in ids)
-        return f'<NodeSet name="{name}">{body}</NodeSet>'
-
-    def held(name: str, node_set: str, axes: str) -> str:
-        dofs = "".join(f"<{a}_dof>{int(a in axes)}</{a}_dof>" for a in "xyz") if four else f"<dofs>{','.join(axes)}</dofs>"
-        return f'<bc name="{name}" type="{"zero displacement" if four else "fix"}" node_set="{node_set}">{dofs}</bc>'
-
     thickness = "<shell_thickness>0.1</shell_thickness>" if four else ""
     data = ("" if four else '<MeshData><ElementData var="shell thickness" elem_set="Plate">'
             '<e lid="1">0.1,0.1,0.1,0.1</e></ElementData></MeshData>')
-    force = ('<value lc="1">100,0,0</value>' if four else '<dof>x</dof><scale lc="1">100</scale>')
     points = "<pt>0,0</pt><pt>1,1</pt>" if four else "<point>0,0</point><point>1,1</point>"
     return f'''<?xml version="1.0" encoding="ISO-8859-1"?>
 <febio_spec version="{version}">
@@ -474,16 +483,16 @@ def tethered_plate_feb(version: str, domain: str = "linear-truss", area: str = "
       <node id="4">0,1,0</node><node id="5">2,0,0</node></Nodes>
     <Elements type="quad4" name="Plate"><elem id="1">1,2,3,4</elem></Elements>
     <Elements type="truss2" name="Chord"><elem id="10">2,5</elem></Elements>
-    {node_set("Root", [1, 4])}{node_set("Pin", [2])}{node_set("End", [5])}
+    {"".join(feb_set(version, "NodeSet", name, ids, "n") for name, ids in (("Root", [1, 4]), ("Pin", [2]), ("End", [5])))}
   </Mesh>
   <MeshDomains><ShellDomain name="Plate" mat="Skin">{thickness}</ShellDomain>
     <BeamDomain name="Chord" mat="Cord" type="{domain}"><cross_sectional_area>{area}</cross_sectional_area></BeamDomain>
   </MeshDomains>
   {data}
-  <Boundary>{held("Root", "Root", "xyz")}
+  <Boundary>{feb_held(version, "Root", "Root", "xyz")}
     <bc name="RootShell" type="zero shell displacement" node_set="Root"><sx_dof>1</sx_dof><sy_dof>1</sy_dof><sz_dof>1</sz_dof></bc>
-    {held("Pin", "Pin", "xyz")}{held("Across", "End", "yz")}</Boundary>
-  <Loads><nodal_load name="Pull" type="{'nodal_force' if four else 'nodal_load'}" node_set="End">{force}</nodal_load></Loads>
+    {feb_held(version, "Pin", "Pin", "xyz")}{feb_held(version, "Across", "End", "yz")}</Boundary>
+  <Loads>{feb_force(version, "Pull", "End", "x", 100.0)}</Loads>
   <LoadData><load_controller id="1" name="Ramp" type="loadcurve">
     <interpolate>LINEAR</interpolate><points>{points}</points></load_controller></LoadData>
 </febio_spec>

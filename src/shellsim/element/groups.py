@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from numba import njit
 
+from ..array_copy import copy_into
+
 from ..lanes import LANES
 
 
@@ -105,6 +107,6 @@ def gather_nodes(shape, nodes, xe, de, he):
     """The mid-surface points, directors and fibre lengths of an edge's or a face's nodes
     (k,) into xe, de (k, 3) and he (k,)."""
     for a in range(nodes.shape[0]):
-        xe[a] = shape.x[nodes[a]]
-        de[a] = shape.d[nodes[a]]
+        copy_into(shape.x[nodes[a]], xe[a])
+        copy_into(shape.d[nodes[a]], de[a])
         he[a] = shape.h[nodes[a]]

@@ -19,6 +19,7 @@ from .assumed_strain import membrane_tying_stresses, project_volumetric, shear_t
 from ..tensor3 import product
 from .kinematics import (add_forces, almansi, field_gradient, global_stress, gradient_vectors, lamina_strain,
                          point_geometry, symmetric_part)
+from ..array_copy import copy_into
 from ..lanes import LANES
 from .stress_update import constant_tensor, convected_layer, hyperelastic_layers
 
@@ -195,7 +196,7 @@ def _strains(steps, rule, group, points, scratch):
             if steps.total or (steps.hyperelastic and gauss):
                 product(jac, group.jac0[p, k], F)
                 if steps.hyperelastic and gauss:
-                    points.FP[p, k] = F
+                    copy_into(F, points.FP[p, k])
             if steps.total:
                 almansi(F, eg, v, det)
             else:
@@ -203,10 +204,10 @@ def _strains(steps, rule, group, points, scratch):
                 field_gradient(group.ue, group.ve, scratch.gN, scratch.gM, F)
                 symmetric_part(F, eg)
                 if steps.keep_gradient and gauss:
-                    points.LP[p, k] = F
+                    copy_into(F, points.LP[p, k])
             lamina_strain(eg, Q[p, k], EPS[p, k], v)
             if steps.hyperelastic and gauss:
-                points.EPS0[p, k] = EPS[p, k]
+                copy_into(EPS[p, k], points.EPS0[p, k])
 
 
 @njit(cache=True, error_model="numpy", inline="always")

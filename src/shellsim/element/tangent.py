@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from .frames import cross, rotate_director
+from ..array_copy import copy_into
 from ..lanes import LANES
 from .groups import gather_element_values, gather_nodal_scalars
 from .response import group_arrays, group_response
@@ -46,9 +47,9 @@ def moved_node(x, d, e1, move, differences, moved):
     step_u, step_r = differences
     xm, dm, e1m = moved
     slot, sign = move // 2, 1.0 if move % 2 == 0 else -1.0
-    xm[:] = x
-    dm[:] = d
-    e1m[:] = e1
+    copy_into(x, xm)
+    copy_into(d, dm)
+    copy_into(e1, e1m)
     if slot < 3:
         xm[slot] += sign * step_u
         # the step as the sum rounded it: far from the origin a step of 1e-9 of an
@@ -132,7 +133,7 @@ def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_
                 _place_node(group, frames, move // 10, lane, (xm, dm, e1m),
                             (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
         if path.incremental:
-            group.stress[:] = base_stress
+            copy_into(base_stress, group.stress)
         # every lane; counted at run time, as the element loop counts, so that one compiled
         # group_response serves both (the literal LANES would compile a second)
         group_response(path, rule, material, group, points, scratch, members.shape[0])

@@ -8,6 +8,7 @@ from typing import ClassVar, Literal, NamedTuple
 import numpy as np
 from numba import njit
 
+from ..array_copy import copy_into
 from ..curve_tables import factor
 from ..element.frames import cross
 from ..element.groups import gather_nodes
@@ -136,8 +137,8 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
             for a in range(3):
                 for i in range(3):
                     ke[3 * a + i, move // 2] += weight * fe[a, i]
-            xe[moved] = shape.x[node]  # the node back in place
-            de[moved] = shape.d[node]
+            copy_into(shape.x[node], xe[moved])  # the node back in place
+            copy_into(shape.d[node], de[moved])
         element = body.slots[body.node_slots[nodes[1]]] // 9
         for a in range(3):
             for b in range(9):

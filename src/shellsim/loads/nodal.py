@@ -9,6 +9,7 @@ from typing import ClassVar, Literal, NamedTuple
 import numpy as np
 from numba import njit
 
+from ..array_copy import copy_into
 from ..curve_tables import factor
 from ..element.frames import rotate_director, to_rotational
 from ..element.shape import EDGE_DN, EDGE_N, EDGE_W
@@ -175,8 +176,8 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
         block[:] = 0.0
         for j in range(2):
             for sign in (1.0, -1.0):
-                d[0] = shape.d[node]
-                e1[0] = shape.e1[node]
+                copy_into(shape.d[node], d[0])
+                copy_into(shape.e1[node], e1[0])
                 turn = sign * step_r
                 rotate_director(d[0], e1[0], turn if j == 0 else 0.0, turn if j == 1 else 0.0)
                 # the moment's director-conjugate force M x d

@@ -10,6 +10,7 @@ from typing import ClassVar, Literal, NamedTuple
 import numpy as np
 from numba import njit
 
+from ..array_copy import copy_into
 from ..curve_tables import factor
 from ..element.frames import cross
 from ..element.groups import gather_nodes
@@ -136,12 +137,12 @@ def add_face_forces(rule, conn, curves, t, shape, loads, f, g):
         nodes = conn[loads.elements[m]]
         gather_nodes(shape, nodes, xe, de, he)
         for a in range(9):
-            fe[a] = f[nodes[a]]  # summed in place: the nodal sums keep the order of every step
-            ge[a] = g[nodes[a]]
+            copy_into(f[nodes[a]], fe[a])  # summed in place: the nodal sums keep the order of every step
+            copy_into(g[nodes[a]], ge[a])
         face_forces(rule, xe, de, he, loads.face[m], pressure, fe, ge)
         for a in range(9):
-            f[nodes[a]] = fe[a]
-            g[nodes[a]] = ge[a]
+            copy_into(fe[a], f[nodes[a]])
+            copy_into(ge[a], g[nodes[a]])
 
 
 @njit(cache=True)
@@ -168,7 +169,7 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
         nodes = conn[loads.elements[m]]
         gather_nodes(shape, nodes, xe, de, he)
         for a in range(9):
-            e1e[a] = shape.e1[nodes[a]]
+            copy_into(shape.e1[nodes[a]], e1e[a])
         ke[:] = 0.0
         for move in range(2 * ELEMENT_DOFS):
             moved, node = move // 10, nodes[move // 10]
@@ -185,9 +186,9 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
                     ke[5 * a + i, column] += weight * fe[a, i]
                     ke[5 * a + 3, column] -= weight * e1e[a, i] * ge[a, i]
                     ke[5 * a + 4, column] -= weight * e2[i] * ge[a, i]
-            xe[moved] = shape.x[node]  # the node back in place
-            de[moved] = shape.d[node]
-            e1e[moved] = shape.e1[node]
+            copy_into(shape.x[node], xe[moved])  # the node back in place
+            copy_into(shape.d[node], de[moved])
+            copy_into(shape.e1[node], e1e[moved])
         element = loads.elements[m]
         for i in range(ELEMENT_DOFS):
             for j in range(ELEMENT_DOFS):

@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 from pydantic import model_validator
 
+from ..array_copy import copy_into
 from ..curve_tables import factor, rate
 from ..element.frames import cross
 from ..element.tangent import moved_node
@@ -221,7 +222,7 @@ def _distance(loads, m, centre, y, normal):
             normal[i] *= loads.side[m]
         return loads.side[m] * gap
     if shape == 0:
-        normal[:] = loads.direction[m]
+        copy_into(loads.direction[m], normal)
         return (y[0] - centre[0]) * normal[0] + (y[1] - centre[1]) * normal[1] + (y[2] - centre[2]) * normal[2]
     for i in range(3):
         normal[i] = y[i] - centre[i]

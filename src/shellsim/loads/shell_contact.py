@@ -38,6 +38,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from ..array_copy import copy_into
 from ..bundles import Shape
 from ..errors import MeshError
 from ..table_types import Name, Positive
@@ -421,7 +422,7 @@ def add_friction(t, model, shape, loads, f, g, v, w):
         if push == 0.0:
             continue
         node = loads.nodes[m]
-        slip[:] = v[node]
+        copy_into(v[node], slip)
         weight = loads.inverse_mass[m]
         for a in range(9):  # N_a from the face's share of the push
             shares[a] = -(pushed[1 + a, 0] * pushed[0, 0] + pushed[1 + a, 1] * pushed[0, 1]
@@ -449,7 +450,7 @@ def item_forces(t, model, shape, loads, out):
     """out (K, 3): the force on each contact node (for the history)."""
     shape = _at_initial_thickness(model, shape)
     _contact_forces(model, shape, loads)
-    out[:] = loads.touch_forces[:, 0]
+    copy_into(loads.touch_forces[:, 0], out)
 
 
 @njit(cache=True)
@@ -575,7 +576,7 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
         if row < 0:
             continue
         nodes[count, 0] = loads.nodes[m]
-        nodes[count, 1:] = loads.faces[row]
+        copy_into(loads.faces[row], nodes[count, 1:])
         for j in range(30):
             node, i = nodes[count, j // 3], j % 3
             kept = x[node, i]

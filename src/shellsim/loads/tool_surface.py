@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+from ..array_copy import copy_into
 from ..errors import MeshError
 from ..mesh_reading import facet_normals, read_triangles
 from .contact_search import cell_faces, fill_grid, near_box
@@ -148,7 +149,7 @@ def signed_distance(tool, group, p, normal):
         return np.inf
     distance = np.sqrt(nearest)
     if distance == 0.0:  # on the surface: the face's normal
-        normal[:] = pseudo[row, FACE]
+        copy_into(pseudo[row, FACE], normal)
         return 0.0
     side = 1.0 if normal[0] * pseudo[row, where, 0] + normal[1] * pseudo[row, where, 1] \
         + normal[2] * pseudo[row, where, 2] >= 0.0 else -1.0

@@ -22,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from ..array_copy import copy_into
 from ..curve_tables import factor
 from ..element.assembly import Assembly, assembly, internal_forces
 from ..element.frames import rotate_director
@@ -199,7 +200,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
             for i in range(3):
                 dx[node, i] = step * v[node, i]
                 x[node, i] += dx[node, i]
-            d_old[:] = d[node]
+            copy_into(d[node], d_old)
             rotate_director(d[node], e1[node], step * w[node, 0], step * w[node, 1])
             for i in range(3):
                 dd[node, i] = d[node, i] - d_old[i]

@@ -26,7 +26,6 @@ at each Gauss point and the tying points they refer to.
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from ..tensor3 import to_global, to_lamina
@@ -218,11 +217,38 @@ def project_volumetric(V, DV, basis, adjoint, count, scratch):
                 weight = 0.5 if adjoint else DV[p, k, lane]
                 for i in range(nb):
                     rhs[i] += basis[p, i] * weight * (V[p, k, 0, lane] + V[p, k, 1, lane])
-            coef = np.linalg.solve(Mb, rhs)
+            _solve_in_place(Mb, rhs)
             for q in range(nq):
                 projected = 0.0
                 for i in range(nb):
-                    projected += basis[q, i] * coef[i]
+                    projected += basis[q, i] * rhs[i]
                 change = (DV[q, k, lane] if adjoint else 0.5) * projected - 0.5 * (V[q, k, 0, lane] + V[q, k, 1, lane])
                 V[q, k, 0, lane] += change
                 V[q, k, 1, lane] += change
+
+
+# in place of np.linalg.solve: LAPACK's binding compiles for seconds on a first run (with a
+# shape check whose message formats both shapes), and allocates two arrays per call
+@njit(cache=True, error_model="numpy")
+def _solve_in_place(M, b):
+    """b (n,) = M^-1 b, by Gaussian elimination with partial pivoting (LAPACK's dgesv);
+    M (n, n) is overwritten by its factors."""
+    n = b.shape[0]
+    for j in range(n):
+        pivot = j
+        for i in range(j + 1, n):
+            if abs(M[i, j]) > abs(M[pivot, j]):
+                pivot = i
+        if pivot != j:
+            for k in range(n):
+                M[j, k], M[pivot, k] = M[pivot, k], M[j, k]
+            b[j], b[pivot] = b[pivot], b[j]
+        for i in range(j + 1, n):
+            factor = M[i, j] / M[j, j]
+            for k in range(j + 1, n):
+                M[i, k] -= factor * M[j, k]
+            b[i] -= factor * b[j]
+    for i in range(n - 1, -1, -1):
+        for k in range(i + 1, n):
+            b[i] -= M[i, k] * b[k]
+        b[i] /= M[i, i]

@@ -213,7 +213,7 @@ def stiffness_product(structure, shape, stress, vu, vr, f, fr, parts):
 
 class ElementLoop:
     """The internal forces as Python calls them where no time loop runs (the static
-    solver's, and a run's first): the groups shared out over threads
+    solver's): the groups shared out over threads
     (:func:`shellsim.threads.over_threads`) by the compiled group run, which releases the
     interpreter's lock, then summed at the nodes as the time loop sums them, so that the
     results are the same to the bit. It spares a static scene compiling the time loop's

@@ -63,7 +63,8 @@ def workspace(model) -> Workspace:
 
 
 # only ever inlined into the time loop (see shellsim.element.assembly.internal_forces), so
-# never compiled, nor cached, on its own; from Python: Simulation.compute_forces
+# never compiled, nor cached, on its own; from Python: Simulation.compute_forces, through
+# the time loop (advance with ``fresh``) or, in a static run, the element loop
 @njit(inline="always")
 def forces(t, model, fields, space):
     """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
@@ -132,7 +133,7 @@ def equal_step(remaining, dt):
 
 
 @njit(cache=True)
-def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
+def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # noqa: PLR0913 (Python's one entry)
     """Take central-difference steps of size ``dt`` until ``t_stop`` or ``max_steps``.
 
     model: :class:`shellsim.bundles.Model`; fields: :class:`shellsim.bundles.Fields`,
@@ -144,6 +145,9 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     balance at the start of the last step taken, whose kinetic energy 1/2 v(n-1/2) M v(n+1/2) is the one central differences
     conserve exactly with the trapezoidal works (a linear undamped system keeps
     internal + kinetic - external constant to round-off). Returns (t, dt_prev, steps).
+    ``fresh``: the forces are evaluated at t first (``max_steps`` 0: only they), so that
+    an explicit run's forces from Python come from the time loop it compiles anyway, not
+    from an element loop and loads compiled once more (a first run's 12 s).
     """
     x, d, e1 = fields.shape.x, fields.shape.d, fields.shape.e1
     v, w, theta, mt, mr = fields.v, fields.w, fields.theta, fields.mt, fields.mr
@@ -157,7 +161,40 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
     d_old = np.empty(3)
     a = np.empty(3)
     steps = 0
-    while steps < max_steps and t < t_stop:
+    step = work_ext = work_int = work_fr = kinetic = 0.0  # set by each step's motion, read after its forces
+    moved = False  # a step has moved the shape since the forces were evaluated
+    # each pass: the forces where the last step (or the caller) left the shape and the step's
+    # second half of work with them, then the next step's motion; one place evaluates the
+    # forces, as the inlined loads' code is compiled once for each
+    while True:
+        if moved or fresh:
+            forces(t, model, fields, space)
+            fresh = False
+        if moved:
+            if space.friction:
+                work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
+            damped = 0.0
+            for node in range(n):
+                for i in range(3):
+                    work_ext += 0.5 * f_ext[node, i] * dx[node, i]
+                    work_int += 0.5 * f_int[node, i] * dx[node, i]
+                    damped += damping * mt[node] * v[node, i] * dx[node, i]
+                for j in range(2):
+                    work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
+                    work_int += 0.5 * fr_int[node, j] * step * w[node, j]
+                    damped += damping * mr[node] * w[node, j] * w[node, j] * step
+            work[INTERNAL] += work_int
+            work[EXTERNAL] += work_ext - work_fr  # the friction forces are among the external ones
+            work[DAMPED] += damped
+            work[FRICTION] -= work_fr
+            dt_prev = step
+            steps += 1
+            if not np.isfinite(work_int + work_ext + kinetic):
+                energy[INTERNAL] = work[INTERNAL]  # let the caller see the failure at once
+                break
+        moved = False
+        if steps >= max_steps or t >= t_stop:
+            break
         step = equal_step(t_stop - t, dt)
         dt_avg = 0.5 * (dt_prev + step)
         c = damping * dt_avg
@@ -217,26 +254,5 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space):
         if space.friction:
             work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
         t += step
-        forces(t, model, fields, space)
-        if space.friction:
-            work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
-        damped = 0.0
-        for node in range(n):
-            for i in range(3):
-                work_ext += 0.5 * f_ext[node, i] * dx[node, i]
-                work_int += 0.5 * f_int[node, i] * dx[node, i]
-                damped += damping * mt[node] * v[node, i] * dx[node, i]
-            for j in range(2):
-                work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
-                work_int += 0.5 * fr_int[node, j] * step * w[node, j]
-                damped += damping * mr[node] * w[node, j] * w[node, j] * step
-        work[INTERNAL] += work_int
-        work[EXTERNAL] += work_ext - work_fr  # the friction forces are among the external ones
-        work[DAMPED] += damped
-        work[FRICTION] -= work_fr
-        dt_prev = step
-        steps += 1
-        if not np.isfinite(work_int + work_ext + kinetic):
-            energy[INTERNAL] = work[INTERNAL]  # let the caller see the failure at once
-            break
+        moved = True
     return t, dt_prev, steps

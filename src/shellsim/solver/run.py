@@ -192,7 +192,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     """A run ready to start: simulation built, probes and a valve's measures resolved, contact springs set from
     the masses and the structure's critical step (:func:`shellsim.loads.calibrate`)."""
     probes = resolve_probes(deck.output.probe, mesh, model)
-    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model), probes=probes,
+    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model, static=deck.solver.method == "static"), probes=probes,
               quality=ElementQuality(mesh))
     run.load_factors = load_factor_columns(deck)
     names = [contact.name for contact in deck.contact]

@@ -51,9 +51,11 @@ class Compiled(NamedTuple):
 
 
 class Simulation:
-    """A model and its state, advanced by central differences."""
+    """A model and its state, advanced by central differences. Its forces from Python
+    come from the compiled time loop, which an explicit run compiles anyway, or, for a
+    ``static`` run, from the element loop, so that a static run compiles no time loop."""
 
-    def __init__(self, model: Model):
+    def __init__(self, model: Model, static: bool = False):
         self.model = model
         n, ne, nq, nt = model.n_nodes, model.n_elements, len(model.rule.wq), len(model.rule.tz)
         shape = Shape(x=model.x0.copy(), d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
@@ -67,8 +69,8 @@ class Simulation:
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
                                  stiffness=TypedCall(stiffness_product),
                                  applied_forces=TypedCall(explicit.applied_forces))
-        #: the internal forces called from Python
-        self.elements = ElementLoop()
+        #: the internal forces called from Python, where no time loop is compiled
+        self.elements = ElementLoop() if static else None
         self._eigenvector: np.ndarray | None = None
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
@@ -126,6 +128,9 @@ class Simulation:
         t, the incremental formulation's from the increments in the workspace: what the
         time loop's :func:`~shellsim.solver.explicit.forces` computes, from Python."""
         m, fields, space = self.model, self.state.fields, self.workspace
+        if self.elements is None:
+            self.compiled.advance(float(t), float(t), 0, 0.0, float(self.state.dt_prev), m, fields, space, True)
+            return
         self.elements.forces(m.structure, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int,
                              space.parts)
         self.compiled.applied_forces(float(t), m, fields, space)
@@ -150,4 +155,4 @@ class Simulation:
     def _advance(self, t_stop: float, dt: float, max_steps: int) -> tuple[float, float, int]:
         s = self.state
         return self.compiled.advance(float(s.t), float(t_stop), int(max_steps), float(dt), float(s.dt_prev), self.model,
-                                     s.fields, self.workspace)
+                                     s.fields, self.workspace, False)

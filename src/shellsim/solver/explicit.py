@@ -147,7 +147,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # 
     internal + kinetic - external constant to round-off). Returns (t, dt_prev, steps).
     ``fresh``: the forces are evaluated at t first (``max_steps`` 0: only they), so that
     an explicit run's forces from Python come from the time loop it compiles anyway, not
-    from an element loop and loads compiled once more (a first run's 12 s).
+    from an element loop and loads compiled once more (5-10 s of a first run).
     """
     x, d, e1 = fields.shape.x, fields.shape.d, fields.shape.e1
     v, w, theta, mt, mr = fields.v, fields.w, fields.theta, fields.mt, fields.mr
@@ -164,8 +164,8 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # 
     step = work_ext = work_int = work_fr = kinetic = 0.0  # set by each step's motion, read after its forces
     moved = False  # a step has moved the shape since the forces were evaluated
     # each pass: the forces where the last step (or the caller) left the shape and the step's
-    # second half of work with them, then the next step's motion; one place evaluates the
-    # forces, as the inlined loads' code is compiled once for each
+    # second half of work with them, then the next step's motion; the forces are evaluated
+    # in this one place, as their inlined loads' code compiles once for every caller
     while True:
         if moved or fresh:
             forces(t, model, fields, space)

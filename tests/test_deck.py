@@ -12,6 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from shellsim.deck import deck_from_data, load_deck, parse_deck
+from shellsim.curve_tables import knot_interval
 from shellsim.deck.curves import Curve
 from shellsim.errors import DeckError
 
@@ -122,6 +123,17 @@ def test_curves_interpolate_as_documented(interpolate, times, expected):
     curve = Curve(t=[0.0, 1.0, 2.0], value=[0.0, 2.0, 2.0], interpolate=interpolate)
     np.testing.assert_allclose(curve(np.array(times)), expected)
     assert curve(times[1]) == pytest.approx(expected[1])
+
+
+def test_a_time_inside_a_long_table_falls_in_the_knot_interval_numpy_finds():
+    """The compiled bisection against np.searchsorted's last knot at or before the time,
+    on tables of up to 40 knots with repeated ones (a jump) and times on the knots."""
+    rng = np.random.default_rng(3)
+    for size in (2, 3, 7, 40):
+        t = np.sort(np.round(rng.uniform(0.0, 10.0, size), 1))
+        t[0], t[-1] = -1.0, 11.0
+        for time in np.concatenate([rng.uniform(-0.99, 10.99, 50), t[1:-1]]):
+            assert knot_interval(t, float(time)) == np.searchsorted(t, time, side="right") - 1
 
 
 def test_linear_extrapolation_continues_the_end_segments():

@@ -23,13 +23,29 @@ def curve_value(t: np.ndarray, v: np.ndarray, interpolate: int, extrapolate: int
         if extrapolate == 1:
             return v[i] + (time - t[i]) / (t[i + 1] - t[i]) * (v[i + 1] - v[i])
         return v[0] if time <= t[0] else v[n - 1]
-    i = np.searchsorted(t, time, side="right") - 1
+    i = knot_interval(t, time)
     u = (time - t[i]) / (t[i + 1] - t[i])
     if interpolate == 1:
         return v[i]
     if interpolate == 2:
         u = u * u * (3.0 - 2.0 * u)
     return v[i] + u * (v[i + 1] - v[i])
+
+
+# a bisection of its own: np.searchsorted compiles numba's comparisons for every dtype,
+# complex ones included, for about a second on a first run
+@njit(cache=True)
+def knot_interval(t, time):
+    """i with t[i] <= time < t[i + 1] (the last such knot where knots repeat), for a time
+    strictly inside the table t (K,), ascending."""
+    low, high = 0, t.shape[0] - 1
+    while high - low > 1:
+        middle = (low + high) // 2
+        if t[middle] <= time:
+            low = middle
+        else:
+            high = middle
+    return low
 
 
 @njit(cache=True)

@@ -9,7 +9,8 @@ import pytest
 
 from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
-from shellsim.element.assembly import ElementLoop, assembly, internal_forces, stiffness_product
+from shellsim.element.assembly import assembly, internal_forces, stiffness_product
+from shellsim.element.static_loop import ElementLoop
 from shellsim.element.masses import lumped_masses
 from shellsim.element.frames import rotate_director
 from shellsim.element.sampling import point_tensors

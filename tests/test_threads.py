@@ -14,7 +14,7 @@ import pytest
 #: A short run of a distorted, pressurised Mooney-Rivlin open tube quarter (free, so it also moves as a body) (Technique 1 with
 #: the fibre-length update) and of the same tube with Technique 2 (incremental, its own
 #: fibre-length update): positions, directors, fibre lengths and stresses after 40 steps,
-#: then the forces evaluated again from Python (shellsim.element.assembly.ElementLoop).
+#: then the forces evaluated again from Python (shellsim.element.static_loop.ElementLoop).
 SCRIPT = """
 import sys
 import numpy as np

@@ -1,6 +1,7 @@
 """The element loop: groups of elements shared out over the threads, their forces summed
 at the nodes in one fixed order; internal forces and the stiffness product K v, in the
-time loop (a parallel loop) and, for the forces, from Python (:class:`ElementLoop`).
+time loop (a parallel loop) and, for the forces, from Python
+(:class:`shellsim.element.static_loop.ElementLoop`).
 
 Results are the same to the last bit for any number of threads: each group writes only
 its own elements' slots of an :class:`Assembly` and of the stresses, and each node then
@@ -18,8 +19,6 @@ from .frames import director_increments, to_rotational
 from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_arrays, group_response
 from .steps import steps_of
-from ..compiled_call import TypedCall
-from ..threads import over_threads
 
 
 class Assembly(NamedTuple):
@@ -74,11 +73,21 @@ def _all_elements(steps, rule, body, material, shape, ux, ud, stress, f, fr, par
     for c in prange(chunks):
         _group_run(c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
                    parts)
-    _after_groups(steps, body, shape, parts, f, fr)
+    after_groups(steps, body, shape, parts, f, fr)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (prange-bound)
+    """The responses of groups start..stop-1, as :func:`run_groups`, in a compiled layer of
+    their own for the parallel loop."""
+    run_groups(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts)
+
+
+# inlined into its two callers, the parallel loop's layer above and the static solver's
+# one entry (shellsim.element.static_loop): a compiled layer of its own in each would
+# optimise and emit the whole element path once more
+@njit(cache=True, error_model="numpy", inline="always")
+def run_groups(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (flat bundles)
     """The responses of groups start..stop-1 into their elements' slots of ``parts`` and
     ``stress``; arguments as :func:`_all_elements`. Element volumes and mean stretches are
     kept when the fibre lengths follow."""
@@ -122,7 +131,7 @@ def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, 
 
 
 @njit(cache=True, error_model="numpy")
-def _after_groups(steps, body, shape, parts, f, fr):
+def after_groups(steps, body, shape, parts, f, fr):
     """What follows the groups' responses in ``parts``: their nodal sums f (n, 3) and fr
     (n, 2), and the fibre lengths of ``shape`` updated when ``steps`` say so."""
     _gather_at_nodes(body, parts, f)
@@ -167,7 +176,7 @@ def _update_fibre_lengths(body, parts, h, incremental):
 @njit(cache=True, error_model="numpy", inline="always")
 def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
     """Internal forces of all elements at the current configuration, in the time loop
-    (from Python: :meth:`ElementLoop.forces`, the same in every bit).
+    (from Python: :meth:`shellsim.element.static_loop.ElementLoop.forces`, the same in every bit).
 
     Parameters
     ----------
@@ -209,25 +218,3 @@ def stiffness_product(structure, shape, stress, vu, vr, f, fr, parts):
     director_increments(vr, shape.d, shape.e1, vd)
     rule, body, material = structure
     _all_elements(steps_of(material, np.bool_(True)), rule, body, material, shape, vu, vd, stress, f, fr, parts)
-
-
-class ElementLoop:
-    """The internal forces as Python calls them where no time loop runs (the static
-    solver's): the groups shared out over threads
-    (:func:`shellsim.threads.over_threads`) by the compiled group run, which releases the
-    interpreter's lock, then summed at the nodes as the time loop sums them, so that the
-    results are the same to the bit. It spares a static scene compiling the time loop's
-    parallel loop: numba wraps three compiled layers around a parallel loop's body, each
-    with the whole element path in it. One per model: each call keeps the argument types
-    of its first."""
-
-    def __init__(self):
-        self._steps, self._groups, self._after = TypedCall(steps_of), TypedCall(_group_run), TypedCall(_after_groups)
-
-    def forces(self, structure, shape, dx, dd, stress, f, fr, parts) -> None:
-        """As :func:`internal_forces`."""
-        rule, body, material = structure
-        steps = self._steps(material, np.bool_(False))
-        over_threads(lambda first, last: self._groups(first, last, steps, rule, body, material, shape, dx, dd, stress,
-                                                      parts), group_count(len(body.conn)))
-        self._after(steps, body, shape, parts, f, fr)

@@ -59,10 +59,10 @@ def moved_node(x, d, e1, move, differences, moved):
     return sign * step_r
 
 
-# a serial loop that releases the interpreter's lock, shared out over threads by its caller
-# (shellsim.threads.over_threads): a parallel loop here cost a quarter of a static run's
-# first compiling, in the three compiled layers numba wraps around a parallel loop's body
-@njit(cache=True, nogil=True, error_model="numpy")
+# inlined into the static solver's one compiled entry (shellsim.element.static_loop), which
+# the element forces share: a compiled layer of its own would optimise and emit the whole
+# element response once more
+@njit(cache=True, error_model="numpy", inline="always")
 def element_tangents(structure, shape, converged, differences, central, elements, k):
     """k (ne, 45, 45): the tangent stiffness of elements ``elements`` = (first, last),
     first..last-1: the derivative of each one's internal nodal forces with respect to its

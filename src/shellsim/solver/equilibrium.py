@@ -15,11 +15,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..element.frames import rotate_directors
-from ..element.tangent import ELEMENT_DOFS, element_tangents
-from ..compiled_call import TypedCall
+from ..element.static_loop import ElementLoop
+from ..element.tangent import ELEMENT_DOFS
 from ..curve_tables import factor
 from ..loads import LoadTangents
-from ..threads import over_threads
 from .simulation import Simulation
 from .tangent_pattern import tangent_pattern
 from .unknowns import SLOTS, unknowns
@@ -61,7 +60,8 @@ class Equilibrium:
         self.step_u = STEP_SHARE * self.element_size
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self._t = 0.0
-        self._tangents = TypedCall(element_tangents)
+        #: the element tangents: the static element loop's, or one of its own beside a time loop
+        self._elements = sim.elements or ElementLoop()
         self._load_tangents = LoadTangents(model)
         #: where the element blocks go in the tangent
         self.pattern = tangent_pattern(model.conn, self.unknowns)
@@ -136,8 +136,7 @@ class Equilibrium:
         k = self.element_k  # every element's block is overwritten: the loads' are added in place
         steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.element_size, FORWARD_ROTATION)
         converged = (space.dx, space.dd, c["stress"])
-        over_threads(lambda first, last: self._tangents(model.structure, shape, converged, steps, central, (first, last),
-                                                        k), len(k))
+        self._elements.tangents(model.structure, shape, converged, steps, central, space.parts, k)
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
         if self._turned:
             blocks = self._element_blocks

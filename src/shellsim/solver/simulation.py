@@ -11,9 +11,10 @@ from typing import NamedTuple
 import numpy as np
 
 from ..bundles import Fields, Shape
-from ..element.assembly import ElementLoop, stiffness_product
+from ..element.assembly import stiffness_product
 from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
+from ..element.static_loop import ElementLoop
 from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..loads import add_masses

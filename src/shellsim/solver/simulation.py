@@ -11,7 +11,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..bundles import Fields, Shape
-from ..element.assembly import stiffness_product
+from ..element.assembly import StiffnessProduct
 from ..element.masses import lumped_masses
 from ..element.sampling import point_tensors
 from ..element.static_loop import ElementLoop
@@ -47,7 +47,7 @@ class Compiled(NamedTuple):
 
     advance: TypedCall
     masses: TypedCall
-    stiffness: TypedCall
+    stiffness: StiffnessProduct
     applied_forces: TypedCall
 
 
@@ -68,7 +68,7 @@ class Simulation:
             energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
-                                 stiffness=TypedCall(stiffness_product),
+                                 stiffness=StiffnessProduct(),
                                  applied_forces=TypedCall(explicit.applied_forces))
         #: the internal forces called from Python, where no time loop is compiled
         self.elements = ElementLoop() if static else None

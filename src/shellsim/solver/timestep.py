@@ -1,7 +1,7 @@
 """Critical time step from the largest natural frequency (thesis 3.16).
 
 lambda_max of M^-1/2 K_L M^-1/2 on the free DOFs by Lanczos, with the stiffness applied
-matrix-free (:func:`shellsim.element.assembly.stiffness_product`). The Ritz value approaches
+matrix-free (:class:`shellsim.element.assembly.StiffnessProduct`). The Ritz value approaches
 lambda_max from below, so its residual norm is added: lambda_max <= theta + |r| (for the
 eigenvalue the Ritz pair has found, which must be the top one).
 

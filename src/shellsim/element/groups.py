@@ -9,7 +9,6 @@ from __future__ import annotations
 from numba import njit
 
 from ..array_copy import copy_into
-
 from ..lanes import LANES
 
 

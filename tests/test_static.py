@@ -16,7 +16,6 @@ from typer.testing import CliRunner
 
 from shellsim.cli import app
 from shellsim.deck import load_deck, parse_deck
-from shellsim.element.assembly import StiffnessProduct
 from shellsim.execute import built_run
 from shellsim.geometry import build_mesh
 from shellsim.model import build_model
@@ -213,7 +212,7 @@ def test_tangent_at_rest_is_the_stiffness_product(path):
     local = eq.unknowns.scatter(v)
     vu = np.einsum("nij,nj->ni", eq.unknowns.frames, local[:, :3])
     f, fr = np.zeros_like(vu), np.zeros((model.n_nodes, 2))
-    StiffnessProduct()(model.structure, s.fields.shape, s.stress, vu, np.ascontiguousarray(local[:, 3:]), f, fr,
+    run.sim.compiled.stiffness(model.structure, s.fields.shape, s.stress, vu, np.ascontiguousarray(local[:, 3:]), f, fr,
                        run.sim.workspace.parts)
     product = eq.unknowns.gather(eq.unknowns.to_local(f, fr))[:eq.unknowns.n_free]
     assert np.linalg.norm(k @ v - product) <= 1e-6 * np.linalg.norm(product)

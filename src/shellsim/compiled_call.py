@@ -3,11 +3,13 @@
 numba's dispatcher works out the type of every argument on every call; for the bundles
 of :mod:`shellsim.bundles` (dozens of arrays) that takes about 1.8 ms a call, far more
 than a small mesh's time step. A :class:`TypedCall` asks the dispatcher once, then calls
-the entry point compiled for those types directly (about 13 us)."""
+the entry point compiled for those types directly (about 13 us). A compiled function handed
+to another as an argument is best handed over :func:`held_by_address`."""
 
 from __future__ import annotations
 
-from numba import typeof
+from numba import njit, typeof, types
+from numba.typed import List
 
 
 class TypedCall:
@@ -24,3 +26,24 @@ class TypedCall:
         result = self.dispatcher(*args)  # compiles, or loads from the cache
         self.entry_point = self.dispatcher.overloads[tuple(typeof(a) for a in args)].entry_point
         return result
+
+
+def held_by_address(dispatcher, signature) -> List:
+    """``dispatcher`` (a numba function) compiled for ``signature`` (argument types exact:
+    no conversions), held for compiled callers that take it as an argument ``f`` and
+    call ``f[0](...)`` through its address, as numba's first-class functions are called.
+
+    A callee named in its caller's code, or handed over as itself, is linked into the
+    caller, whose compiling then optimises and emits the callee's whole code once more.
+    The holder is a typed list of one: a first-class function handed over from Python
+    is looked up on every call (about 0.1 ms), a typed list only once, here."""
+    function_type = types.FunctionType(signature)
+    _hold.compile((function_type,))  # or loads it from the cache
+    return _hold.overloads[(function_type,)].entry_point(dispatcher)
+
+
+@njit(cache=True)
+def _hold(function):
+    held = List()
+    held.append(function)
+    return held

@@ -17,7 +17,7 @@ from numba import get_num_threads, njit, prange
 
 from .frames import director_increments, to_rotational
 from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
-from .response import group_arrays, group_response
+from .response import group_arrays
 from .steps import steps_of
 from ..compiled_call import TypedCall
 
@@ -47,11 +47,13 @@ def assembly(n_nodes: int, n_elements: int) -> Assembly:
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _all_elements(steps, rule, body, material, shape, ux, ud, stress, f, fr, parts):  # noqa: PLR0913 (prange-bound: flat bundles)
+def _all_elements(response, steps, rule, body, material, shape, ux, ud, stress, f, fr, parts):  # noqa: PLR0913 (prange-bound: flat bundles)
     """Sum the element responses into nodal forces f (n, 3) and rotational forces fr (n, 2).
 
-    steps: :class:`shellsim.element.steps.Steps`; ux, ud (n, 3) the field's translations
-    and director increments (not total); stress (ne, nq, nt, 5) written (read too when
+    response: :func:`shellsim.element.response.group_response`, by its address
+    (:func:`~shellsim.element.response.response_by_address`); steps:
+    :class:`shellsim.element.steps.Steps`; ux, ud (n, 3) the field's translations and
+    director increments (not total); stress (ne, nq, nt, 5) written (read too when
     incremental), or, for the product, the state's stress (read only).
 
     With Techniques 2 and 3 (convected), the fibre lengths are scaled each step by
@@ -72,23 +74,22 @@ def _all_elements(steps, rule, body, material, shape, ux, ud, stress, f, fr, par
     # the chunks' bodies run in a function of their own: a nested bundle cannot cross into
     # a prange body, and code written inline there was compiled wrongly
     for c in prange(chunks):
-        _group_run(c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
+        _group_run(response, c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
                    parts)
     after_groups(steps, body, shape, parts, f, fr)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _group_run(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (prange-bound)
+def _group_run(response, start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (prange-bound)
     """The responses of groups start..stop-1, as :func:`run_groups`, in a compiled layer of
     their own for the parallel loop."""
-    run_groups(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts)
+    run_groups(response, start, stop, steps, rule, body, material, shape, ux, ud, stress, parts)
 
 
 # inlined into its two callers, the parallel loop's layer above and the static solver's
-# one entry (shellsim.element.static_loop): a compiled layer of its own in each would
-# optimise and emit the whole element path once more
+# one entry (shellsim.element.static_loop)
 @njit(cache=True, error_model="numpy", inline="always")
-def run_groups(start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (flat bundles)
+def run_groups(response, start, stop, steps, rule, body, material, shape, ux, ud, stress, parts):  # noqa: PLR0913 (flat bundles)
     """The responses of groups start..stop-1 into their elements' slots of ``parts`` and
     ``stress``; arguments as :func:`_all_elements`. Element volumes and mean stretches are
     kept when the fibre lengths follow."""
@@ -109,7 +110,7 @@ def run_groups(start, stop, steps, rule, body, material, shape, ux, ud, stress, 
             gather_element_values(stress, members, group.stress)
         if steps.product:
             gather_element_values(stress, members, group.state_stress)
-        group_response(steps, rule, material, group, points, scratch, count)
+        response[0](steps, rule, material, group, points, scratch, count)
         if not steps.product:  # the K v product's stresses are the field's, of no use after
             scatter_element_values(group.stress, members, count, stress)
         for lane in range(count):
@@ -172,15 +173,16 @@ def _update_fibre_lengths(body, parts, h, incremental):
 
 
 # inlined into the time step (shellsim.solver.explicit.forces): a compiled layer of its own
-# would copy, optimise and emit the whole element path once more (numba links each callee's
-# code into its caller's), for a function that only passes its arguments on
+# would only pass its arguments on
 @njit(cache=True, error_model="numpy", inline="always")
-def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
+def internal_forces(response, structure, shape, dx, dd, stress, f, fr, parts):  # noqa: PLR0913 (flat bundles)
     """Internal forces of all elements at the current configuration, in the time loop
     (from Python: :meth:`shellsim.element.static_loop.ElementLoop.forces`, the same in every bit).
 
     Parameters
     ----------
+    response : :func:`shellsim.element.response.group_response` by its address
+        (:func:`~shellsim.element.response.response_by_address`).
     structure : (rule, body, material) of a :class:`shellsim.bundles.Model` (its
         ``structure``; the material's path, :class:`~shellsim.bundles.Material`, says how.
         Not the model: its type changes with the load kinds a scene has, and this would
@@ -195,10 +197,10 @@ def internal_forces(structure, shape, dx, dd, stress, f, fr, parts):
     f : (n, 3) translational forces, fr : (n, 2) rotational forces, both overwritten.
     parts : :class:`Assembly` of the mesh (scratch).
     """
-    # a run-time boolean: a constant would type as a literal and compile the whole element
-    # path once more for the product (half of a cold start's compiling)
+    # a run-time boolean, as the response's signature takes it (a constant would type as a
+    # literal)
     rule, body, material = structure
-    _all_elements(steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress, f, fr, parts)
+    _all_elements(response, steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress, f, fr, parts)
 
 
 class StiffnessProduct:
@@ -209,15 +211,15 @@ class StiffnessProduct:
     from K_L alone was too long on refined meshes).
 
     Called from Python (the critical step's estimates call it thousands of times): the
-    time loop's own parallel loop, :func:`_all_elements`, with the product's ``Steps``. A
-    compiled function of its own around that loop would optimise and emit the whole element
-    path once more (4.1 s of an explicit run's first compiling). Each call keeps the
-    argument types of its first.
+    time loop's own parallel loop, :func:`_all_elements`, with the product's ``Steps``: a
+    compiled function of its own around that loop would compile the loop once more. Each
+    call keeps the argument types of its first; ``response`` is the element response by
+    its address (:func:`shellsim.element.response.response_by_address`).
     """
 
-    def __init__(self):
+    def __init__(self, response):
         self._steps, self._turn = TypedCall(steps_of), TypedCall(director_increments)
-        self._elements = TypedCall(_all_elements)
+        self._elements, self._response = TypedCall(_all_elements), response
 
     def __call__(self, structure, shape, stress, vu, vr, f, fr, parts) -> None:
         """vu (n, 3) translational and vr (n, 2) rotational components of v; writes f
@@ -226,5 +228,5 @@ class StiffnessProduct:
         vd = np.empty((len(shape.x), 3))
         self._turn(vr, shape.d, shape.e1, vd)
         rule, body, material = structure
-        self._elements(self._steps(material, np.bool_(True)), rule, body, material, shape, vu, vd, stress, f, fr,
-                       parts)
+        self._elements(self._response, self._steps(material, np.bool_(True)), rule, body, material, shape, vu, vd,
+                       stress, f, fr, parts)

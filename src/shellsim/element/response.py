@@ -13,14 +13,16 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, typeof, types
 
 from .assumed_strain import membrane_tying_stresses, project_volumetric, shear_tying_stresses, tie_membrane, tie_shear
 from ..tensor3 import product
 from .kinematics import (add_forces, almansi, field_gradient, global_stress, gradient_vectors, lamina_strain,
                          point_geometry, symmetric_part)
 from ..array_copy import copy_into
+from ..compiled_call import held_by_address
 from ..lanes import LANES
+from .steps import steps_of
 from .stress_update import constant_tensor, convected_layer, hyperelastic_layers
 
 
@@ -172,6 +174,20 @@ def group_response(steps, rule, material, group, points, scratch, count):
     _point_forces(rule, group, points, scratch, nq)
     if steps.product:
         _initial_stress_forces(rule, group, points, scratch, nq)
+
+
+def response_by_address(rule, material):
+    """:func:`group_response` for the element loops of a model with this ``rule`` and
+    ``material`` (:class:`shellsim.bundles.Rule`, :class:`~shellsim.bundles.Material`),
+    held for calls through its address (:func:`shellsim.compiled_call.held_by_address`:
+    the loops call ``response[0](...)``). Each loop that named it would link the whole
+    element path into its own code and optimise and emit it again: seconds of a first run
+    for each of the static entry, the time loop and the parallel loop's layers."""
+    nq, nt = rule.wq.shape[0], rule.tz.shape[0]
+    arrays = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
+    steps = steps_of(material, np.bool_(False))  # the product's are of the same type
+    return held_by_address(group_response, types.none(typeof(steps), typeof(rule), typeof(material),
+                                                      *(typeof(a) for a in arrays), types.int64))
 
 
 @njit(cache=True, error_model="numpy", inline="always")

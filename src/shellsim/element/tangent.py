@@ -26,7 +26,7 @@ from .frames import cross, rotate_director
 from ..array_copy import copy_into
 from ..lanes import LANES
 from .groups import gather_element_values, gather_nodal_scalars
-from .response import group_arrays, group_response
+from .response import group_arrays
 from .steps import steps_of
 
 #: DOFs of an element: 9 nodes x (3 translations, 2 rotations).
@@ -60,16 +60,17 @@ def moved_node(x, d, e1, move, differences, moved):
 
 
 # inlined into the static solver's one compiled entry (shellsim.element.static_loop), which
-# the element forces share: a compiled layer of its own would optimise and emit the whole
-# element response once more
+# the element forces share
 @njit(cache=True, error_model="numpy", inline="always")
-def element_tangents(structure, shape, converged, differences, central, elements, k):
+def element_tangents(response, structure, shape, converged, differences, central, elements, k):
     """k (ne, 45, 45): the tangent stiffness of elements ``elements`` = (first, last),
     first..last-1: the derivative of each one's internal nodal forces with respect to its
     DOFs (both in the module's order), by forward differences, or central ones when
     ``central``. The other elements' blocks are left as they are.
 
-    structure: (rule, body, material) of a :class:`~shellsim.bundles.Model`; shape: the
+    response: :func:`shellsim.element.response.group_response` by its address
+    (:func:`~shellsim.element.response.response_by_address`); structure: (rule, body,
+    material) of a :class:`~shellsim.bundles.Model`; shape: the
     current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
     increments (n, 3) of position and director since the last converged state and the
     stress (ne, nq, nt, 5) there (read by an incremental material only); differences:
@@ -82,7 +83,7 @@ def element_tangents(structure, shape, converged, differences, central, elements
     path = steps_of(material, np.bool_(False))
     first, last = elements
     for e in range(first, last):
-        _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, k[e])
+        _element_tangent(response, e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, k[e])
 
 
 @njit(cache=True)
@@ -95,10 +96,8 @@ def lane_move(k, central):
     return 2 * (k - 1) if 1 <= k <= ELEMENT_DOFS else -1
 
 
-# inlined into its one caller: a compiled layer of its own would optimise and emit the
-# whole element response once more (see shellsim.element.assembly.internal_forces)
 @njit(cache=True, error_model="numpy", inline="always")
-def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, ke):  # noqa: PLR0913 (flat bundles)
+def _element_tangent(response, e, path, rule, body, material, shape, dx, dd, stress, step_u, step_r, central, ke):  # noqa: PLR0913 (flat bundles)
     """ke (45, 45) of element e; arguments as :func:`element_tangents`, ``path`` its
     :class:`~shellsim.element.steps.Steps`. Every lane holds the element as it is; each
     batch moves one node of each lane (:func:`lane_move`) and puts it back after."""
@@ -134,9 +133,8 @@ def _element_tangent(e, path, rule, body, material, shape, dx, dd, stress, step_
                             (dx[node] + xm - shape.x[node], dd[node] + dm - shape.d[node]))
         if path.incremental:
             copy_into(base_stress, group.stress)
-        # every lane; counted at run time, as the element loop counts, so that one compiled
-        # group_response serves both (the literal LANES would compile a second)
-        group_response(path, rule, material, group, points, scratch, members.shape[0])
+        # every lane; counted at run time, as the response's signature takes it
+        response[0](path, rule, material, group, points, scratch, members.shape[0])
         for lane in range(LANES):
             move = lane_move(batch * LANES + lane, central)
             if move < 0:

@@ -61,7 +61,7 @@ class Equilibrium:
         self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self._t = 0.0
         #: the element tangents: the static element loop's, or one of its own beside a time loop
-        self._elements = sim.elements or ElementLoop()
+        self._elements = sim.elements or ElementLoop(sim.response)
         self._load_tangents = LoadTangents(model)
         #: where the element blocks go in the tangent
         self.pattern = tangent_pattern(model.conn, self.unknowns)

@@ -66,11 +66,12 @@ def workspace(model) -> Workspace:
 # never compiled, nor cached, on its own; from Python: Simulation.compute_forces, through
 # the time loop (advance with ``fresh``) or, in a static run, the element loop
 @njit(inline="always")
-def forces(t, model, fields, space):
+def forces(response, t, model, fields, space):
     """Internal and external forces at time t into ``fields`` (:class:`shellsim.bundles.Fields`):
     f_* (n, 3) translational, fr_* (n, 2) rotational, and the stresses. The internal
-    forces of the incremental formulation take the last step's increments from ``space``."""
-    internal_forces((model.rule, model.body, model.material), fields.shape, space.dx, space.dd, fields.stress,
+    forces of the incremental formulation take the last step's increments from ``space``;
+    ``response``: the element response by its address."""
+    internal_forces(response, (model.rule, model.body, model.material), fields.shape, space.dx, space.dd, fields.stress,
                     fields.f_int, fields.fr_int, space.parts)
     applied_forces(t, model, fields, space)
 
@@ -133,9 +134,11 @@ def equal_step(remaining, dt):
 
 
 @njit(cache=True)
-def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # noqa: PLR0913 (Python's one entry)
+def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # noqa: PLR0913 (Python's one entry)
     """Take central-difference steps of size ``dt`` until ``t_stop`` or ``max_steps``.
 
+    response: the element response by its address
+    (:func:`shellsim.element.response.response_by_address`);
     model: :class:`shellsim.bundles.Model`; fields: :class:`shellsim.bundles.Fields`,
     updated in place; space: a :class:`Workspace`. On entry the forces in ``fields``
     must be those at time t; on return they are those at the returned time. ``dt_prev``
@@ -168,7 +171,7 @@ def advance(t, t_stop, max_steps, dt, dt_prev, model, fields, space, fresh):  # 
     # in this one place, as their inlined loads' code compiles once for every caller
     while True:
         if moved or fresh:
-            forces(t, model, fields, space)
+            forces(response, t, model, fields, space)
             fresh = False
         if moved:
             if space.friction:

@@ -13,6 +13,7 @@ import numpy as np
 from ..bundles import Fields, Shape
 from ..element.assembly import StiffnessProduct
 from ..element.masses import lumped_masses
+from ..element.response import response_by_address
 from ..element.sampling import point_tensors
 from ..element.static_loop import ElementLoop
 from ..compiled_call import TypedCall
@@ -67,11 +68,13 @@ class Simulation:
             prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(explicit.ENERGIES),
             energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
+        #: the element response, called by its address from every compiled element loop
+        self.response = response_by_address(model.rule, model.material)
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
-                                 stiffness=StiffnessProduct(),
+                                 stiffness=StiffnessProduct(self.response),
                                  applied_forces=TypedCall(explicit.applied_forces))
         #: the internal forces called from Python, where no time loop is compiled
-        self.elements = ElementLoop() if static else None
+        self.elements = ElementLoop(self.response) if static else None
         self._eigenvector: np.ndarray | None = None
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
@@ -130,7 +133,8 @@ class Simulation:
         time loop's :func:`~shellsim.solver.explicit.forces` computes, from Python."""
         m, fields, space = self.model, self.state.fields, self.workspace
         if self.elements is None:
-            self.compiled.advance(float(t), float(t), 0, 0.0, float(self.state.dt_prev), m, fields, space, True)
+            self.compiled.advance(self.response, float(t), float(t), 0, 0.0, float(self.state.dt_prev), m, fields, space,
+                                  True)
             return
         self.elements.forces(m.structure, fields.shape, space.dx, space.dd, fields.stress, fields.f_int, fields.fr_int,
                              space.parts)
@@ -155,5 +159,5 @@ class Simulation:
 
     def _advance(self, t_stop: float, dt: float, max_steps: int) -> tuple[float, float, int]:
         s = self.state
-        return self.compiled.advance(float(s.t), float(t_stop), int(max_steps), float(dt), float(s.dt_prev), self.model,
-                                     s.fields, self.workspace, False)
+        return self.compiled.advance(self.response, float(s.t), float(t_stop), int(max_steps), float(dt),
+                                     float(s.dt_prev), self.model, s.fields, self.workspace, False)

@@ -13,7 +13,7 @@ from shellsim.bundles import Material
 from shellsim.element.steps import HYPERELASTIC
 from shellsim.lanes import LANES
 from shellsim.materials import zero_normal_stress as zns
-from shellsim.materials.laws import LAWS, energy, law_of
+from shellsim.materials.laws import LAWS, held_law, law_of
 
 PARAMETERS = {
     "mooney_rivlin": np.array([0.2e6, 0.05e6]),
@@ -33,9 +33,11 @@ def material(case: str) -> Material:
     """The kernels' bundle for the law serving the model of ``case`` with its
     :data:`PARAMETERS`."""
     code, law = law_of(MODEL_OF.get(case, case))
+    energy_stress, energy_tangent = held_law(code)
     return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=False, law=code,
-                    params=PARAMETERS[case], incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)),
-                    C=np.zeros((5, 5)), normal_ratio=0.0)
+                    energy_stress=energy_stress, energy_tangent=energy_tangent, params=PARAMETERS[case],
+                    incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)), C=np.zeros((5, 5)),
+                    normal_ratio=0.0)
 
 
 def random_strains(rng, size):
@@ -65,7 +67,7 @@ def reduced_energy(mat, E):
     E = E.copy()
     stretch, W = np.empty(LANES), np.empty(LANES)
     zns.normal_strain(mat, E, stretch, np.empty((3, 3, 3, LANES)))
-    energy(mat.law, mat.params, E, W)
+    LAWS[mat.law].energy(mat.params, E, W)
     return W
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numba.typed import List
 
 
 class Rule(NamedTuple):
@@ -64,7 +65,10 @@ class Material(NamedTuple):
     strain by choice, convected always); push_forward: Technique 2's stretch of the
     accumulated stresses; thickness_update: the fibre lengths follow the normal stretch
     (thesis 3.11). law: the code of a hyperelastic law (:mod:`shellsim.materials.laws`);
-    params (P,): its parameters; incompressible: whether it keeps J = 1; axes0
+    energy_stress, energy_tangent: its S^w and CC^w : dE, each held for calls through its
+    address, ``material.energy_stress[0](params, E, S)``
+    (:func:`~shellsim.materials.laws.held_law`; the first law's, never called, on the
+    other paths); params (P,): its parameters; incompressible: whether it keeps J = 1; axes0
     (ne, nq, nt, 3, 3) its initial material frames (rows a1, a2, a3; (1, ...) unused
     otherwise). C (5, 5): reduced lamina matrix of the constant tensor [stress] (the other
     paths); normal_ratio: nu / (1 - nu), the normal strain increment per in-plane one of
@@ -76,6 +80,8 @@ class Material(NamedTuple):
     push_forward: bool
     thickness_update: bool
     law: int
+    energy_stress: List
+    energy_tangent: List
     params: np.ndarray
     incompressible: bool
     axes0: np.ndarray

@@ -20,7 +20,7 @@ from .element.frames import initial_fibre_frame
 from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .loads import DECK_KEYS, LoadScene, build_loads
-from .materials.laws import law_of
+from .materials.laws import held_law, law_of
 from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh, inverse_jacobians, layer_geometry
 
@@ -111,6 +111,8 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
     no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
     constant = dict(push_forward=False, law=0, params=np.zeros(1), incompressible=False, axes0=no_axes,
                     normal_ratio=0.0)
+    if section.technique in (None, 2, 3):  # no law: the first law's functions, held and never called
+        constant |= dict(zip(("energy_stress", "energy_tangent"), held_law(0), strict=True))
     if section.technique is None:
         return Material(path=SMALL_STRAIN, incremental=section.formulation == "incremental", thickness_update=False,
                         C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), **constant)
@@ -123,9 +125,10 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
                                        "normal_ratio": material.nu / (1.0 - material.nu)}))
     code, law = law_of(material.model)
     axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
+    energy_stress, energy_tangent = held_law(code)
     return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=deck.thickness_update,
-                    law=code, params=law.parameters(material), incompressible=law.INCOMPRESSIBLE, axes0=axes0,
-                    C=np.zeros((5, 5)), normal_ratio=0.0)
+                    law=code, energy_stress=energy_stress, energy_tangent=energy_tangent, params=law.parameters(material),
+                    incompressible=law.INCOMPRESSIBLE, axes0=axes0, C=np.zeros((5, 5)), normal_ratio=0.0)
 
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:

@@ -1,5 +1,5 @@
-"""The hyperelastic laws of Technique 1 (thesis 3.10.1): their registry, and their
-compiled functions called by a law's code (its place in :data:`LAWS`).
+"""The hyperelastic laws of Technique 1 (thesis 3.10.1): their registry, and a law's
+compiled functions held for the element path (:func:`held_law`).
 
 A law is one module of this package with
 - ``INCOMPRESSIBLE``: J = 1 (zero normal stress by the determinant condition), or a
@@ -18,8 +18,9 @@ Adding a law is writing its module and adding it to :data:`LAWS`.
 
 from __future__ import annotations
 
-from numba import njit
+from numba import types
 
+from ..compiled_call import held_by_address
 from ..table_types import tag_of
 from . import guccione, hgo, lee_sacks, mooney_rivlin, st_venant_kirchhoff
 
@@ -35,38 +36,15 @@ def law_of(model: str):
     raise KeyError(f"no hyperelastic law serves material.model = {model!r}")
 
 
-def _by_code(name: str, code: int = 0):
-    """A compiled f(code, params, *arrays) that calls LAWS[code].<name>(params, *arrays):
-    one inlined branch per law. Compiled code cannot call a function held in a value and
-    still be cached, so the branches are built here, once per function name, for the
-    two arities of the law functions (two or three arrays)."""
-    law = getattr(LAWS[code], name)
-    three_arrays = law.py_func.__code__.co_argcount == 4
-    if code == len(LAWS) - 1:
-        if three_arrays:
-            return njit(inline="always")(lambda which, params, a, b, c: law(params, a, b, c))
-        return njit(inline="always")(lambda which, params, a, b: law(params, a, b))
-    others = _by_code(name, code + 1)
-    if three_arrays:
-        @njit(inline="always")
-        def branch3(which, params, a, b, c):
-            if which == code:
-                law(params, a, b, c)
-            else:
-                others(which, params, a, b, c)
-        return branch3
-
-    @njit(inline="always")
-    def branch2(which, params, a, b):
-        if which == code:
-            law(params, a, b)
-        else:
-            others(which, params, a, b)
-    return branch2
+#: The types of a law's lane functions: params (P,), then tensors (3, 3, G).
+_PARAMS, _TENSOR = types.Array(types.float64, 1, "C"), types.Array(types.float64, 3, "C")
 
 
-#: energy(code, params, E, W), energy_stress(code, params, E, S),
-#: energy_tangent(code, params, E, dE, dS) of the law with that code.
-energy = _by_code("energy")
-energy_stress = _by_code("energy_stress")
-energy_tangent = _by_code("energy_tangent")
+def held_law(code: int) -> tuple:
+    """(energy_stress, energy_tangent) of the law with that code, held for the element
+    path (:class:`shellsim.bundles.Material`), which calls them through their addresses
+    (:func:`shellsim.compiled_call.held_by_address`): only a scene's own law compiles,
+    and the element path compiles none of the laws' code into its own."""
+    law = LAWS[code]
+    return (held_by_address(law.energy_stress, types.none(_PARAMS, _TENSOR, _TENSOR)),
+            held_by_address(law.energy_tangent, types.none(_PARAMS, _TENSOR, _TENSOR, _TENSOR)))

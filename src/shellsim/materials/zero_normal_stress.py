@@ -21,8 +21,8 @@ Compressible laws (St. Venant-Kirchhoff) whose S^w_33 is linear in E33: S_33 = 0
 E33 = -S^w_33(E33 = 0) / CC^w_3333 and dE33 = -(CC^w : dE)_33 / CC^w_3333 for a dE with
 no normal part; S~ = S^w, no pressure, J = sqrt(det C).
 
-The law's own S^w and CC^w : dE come from :mod:`shellsim.materials.laws` by its code;
-``material`` is the kernels' :class:`shellsim.bundles.Material` (law, params,
+The law's own S^w and CC^w : dE are the functions ``material`` holds (the kernels'
+:class:`shellsim.bundles.Material`: energy_stress, energy_tangent, params,
 incompressible). Scratch ``work`` (3, 3, 3, G).
 """
 
@@ -33,7 +33,6 @@ from numba import njit
 
 from ..lanes import LANES
 from ..tensor3 import det3, to_lamina
-from .laws import energy_stress, energy_tangent
 
 
 @njit(cache=True, error_model="numpy")
@@ -48,8 +47,8 @@ def normal_strain(material, E, stretch, work):
     for lane in range(LANES):
         E[2, 2, lane] = 0.0
         unit[2, 2, lane] = 1.0
-    energy_stress(material.law, material.params, E, S)
-    energy_tangent(material.law, material.params, E, unit, dS)
+    material.energy_stress[0](material.params, E, S)
+    material.energy_tangent[0](material.params, E, unit, dS)
     for lane in range(LANES):
         E[2, 2, lane] = -S[2, 2, lane] / dS[2, 2, lane]
         stretch[lane] = np.sqrt(1.0 + 2.0 * E[2, 2, lane])
@@ -80,7 +79,7 @@ def stress(material, E, S, Cinv, pressure, volume, work):
     normal_strain(material, E, volume, work)
     if material.incompressible:
         _inverse_stretch(E, Cinv)
-        energy_stress(material.law, material.params, E, S)
+        material.energy_stress[0](material.params, E, S)
         for lane in range(LANES):
             pressure[lane] = S[2, 2, lane] / Cinv[2, 2, lane]
             volume[lane] = 1.0
@@ -89,7 +88,7 @@ def stress(material, E, S, Cinv, pressure, volume, work):
                 for lane in range(LANES):
                     S[i, j, lane] -= pressure[lane] * Cinv[i, j, lane]
     else:
-        energy_stress(material.law, material.params, E, S)
+        material.energy_stress[0](material.params, E, S)
         C = work[0]
         for i in range(3):
             for j in range(3):
@@ -107,7 +106,7 @@ def stress(material, E, S, Cinv, pressure, volume, work):
 def tangent(material, E, Cinv, pressure, dE, dS, work):
     """dS~ (3, 3, G) for strain directions dE (3, 3, G) at a solved state (E, Cinv,
     pressure from :func:`stress`). dE[2, 2] is overwritten by the constraint's value."""
-    law, params = material.law, material.params
+    energy_tangent, params = material.energy_tangent[0], material.params
     if material.incompressible:
         for lane in range(LANES):
             acc = 0.0
@@ -118,7 +117,7 @@ def tangent(material, E, Cinv, pressure, dE, dS, work):
             dE[2, 2, lane] = -acc / Cinv[2, 2, lane]
         CdC = work[0]  # dCinv = -2 Cinv dE Cinv
         to_lamina(Cinv, dE, CdC)
-        energy_tangent(law, params, E, dE, dS)
+        energy_tangent(params, E, dE, dS)
         for lane in range(LANES):
             dp = (dS[2, 2, lane] + 2.0 * pressure[lane] * CdC[2, 2, lane]) / Cinv[2, 2, lane]
             for i in range(3):
@@ -130,8 +129,8 @@ def tangent(material, E, Cinv, pressure, dE, dS, work):
         for lane in range(LANES):
             dE[2, 2, lane] = 0.0
             unit[2, 2, lane] = 1.0
-        energy_tangent(law, params, E, unit, normal)
-        energy_tangent(law, params, E, dE, dS)
+        energy_tangent(params, E, unit, normal)
+        energy_tangent(params, E, dE, dS)
         # the tangent is linear in dE: adding dE33 adds dE33 times the unit's response
         for lane in range(LANES):
             dE[2, 2, lane] = -dS[2, 2, lane] / normal[2, 2, lane]

@@ -3,8 +3,9 @@
 numba's dispatcher works out the type of every argument on every call; for the bundles
 of :mod:`shellsim.bundles` (dozens of arrays) that takes about 1.8 ms a call, far more
 than a small mesh's time step. A :class:`TypedCall` asks the dispatcher once, then calls
-the entry point compiled for those types directly (about 13 us). A compiled function handed
-to another as an argument is best handed over :func:`held_by_address`."""
+the entry point compiled for those types directly (about 13 us). A compiled function that
+other compiled functions take as an argument is handed to them held
+(:func:`held_by_address`), and they call it through its address."""
 
 from __future__ import annotations
 

@@ -2,7 +2,8 @@
 internal forces of element groups, summed at the nodes as the time loop sums them, and
 the tangent blocks of elements, both through one compiled entry.
 
-The entry calls the element response through its address
+One entry, whose compiling the gathers and the group's arrays then need once, for both.
+It calls the element response through its address
 (:func:`shellsim.element.response.response_by_address`), so its compiling does not take
 in the response's code. It is a serial loop that releases the interpreter's lock, shared
 out over threads from Python (:func:`shellsim.threads.over_threads`): it spares a static
@@ -40,6 +41,7 @@ def static_elements(response, first, last, tangents, structure, shape, converged
     dx, dd, stress = converged
     run_groups(response, first, last, steps_of(material, np.bool_(False)), rule, body, material, shape, dx, dd, stress,
                parts)
+
 
 #: What a forces call passes for the tangent's arguments: the same types, nothing done with them.
 _NO_STEPS = (0.0, 0.0)

@@ -74,8 +74,8 @@ def _all_elements(response, steps, rule, body, material, shape, ux, ud, stress, 
     # the chunks' bodies run in a function of their own: a nested bundle cannot cross into
     # a prange body, and code written inline there was compiled wrongly
     for c in prange(chunks):
-        _group_run(response, c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud, stress,
-                   parts)
+        _group_run(response, c * groups // chunks, (c + 1) * groups // chunks, steps, rule, body, material, shape, ux, ud,
+                   stress, parts)
     after_groups(steps, body, shape, parts, f, fr)
 
 

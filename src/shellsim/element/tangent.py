@@ -70,10 +70,10 @@ def element_tangents(response, structure, shape, converged, differences, central
 
     response: :func:`shellsim.element.response.group_response` by its address
     (:func:`~shellsim.element.response.response_by_address`); structure: (rule, body,
-    material) of a :class:`~shellsim.bundles.Model`; shape: the
-    current :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the
-    increments (n, 3) of position and director since the last converged state and the
-    stress (ne, nq, nt, 5) there (read by an incremental material only); differences:
+    material) of a :class:`~shellsim.bundles.Model`; shape: the current
+    :class:`~shellsim.bundles.Shape`; converged: (dx, dd, stress), the increments (n, 3)
+    of position and director since the last converged state and the stress
+    (ne, nq, nt, 5) there (read by an incremental material only); differences:
     (step_u [length], step_r [rad]), the difference steps. The fibre lengths are held
     (their update follows the deformation one evaluation behind).
     """

@@ -43,8 +43,23 @@ def held_by_address(dispatcher, signature) -> List:
     return _hold.overloads[(function_type,)].entry_point(dispatcher)
 
 
+def hold_instead(held: List, dispatcher, signature) -> None:
+    """Put ``dispatcher``, compiled for ``signature`` (or loaded from the cache), in the
+    holder ``held`` (:func:`held_by_address`, the same signature) in place of the function
+    it holds: the callers given the holder call it from then on."""
+    function_type = types.FunctionType(signature)
+    argument_types = (typeof(held), function_type)
+    _put.compile(argument_types)  # or loads it from the cache
+    _put.overloads[argument_types].entry_point(held, dispatcher)
+
+
 @njit(cache=True)
 def _hold(function):
     held = List()
     held.append(function)
     return held
+
+
+@njit(cache=True)
+def _put(held, function):
+    held[0] = function

@@ -183,11 +183,29 @@ def response_by_address(rule, material):
     the loops call ``response[0](...)``). Each loop that named it would link the whole
     element path into its own code and optimise and emit it again: seconds of a first run
     for each of the static entry, the time loop and the parallel loop's layers."""
+    return held_by_address(group_response, response_signature(rule, material))
+
+
+def response_signature(rule, material):
+    """The numba signature of :func:`group_response` (and of :func:`no_response`) for a
+    model with this ``rule`` and ``material``. The arrays and decisions are made by the
+    Python versions of :func:`group_arrays` and ``steps_of``, of the same types: compiling
+    them first would hold up a second process compiling the response by about 1.5 s of a
+    first run (:mod:`shellsim.compile_beside`)."""
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
-    arrays = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
-    steps = steps_of(material, np.bool_(False))  # the product's are of the same type
-    return held_by_address(group_response, types.none(typeof(steps), typeof(rule), typeof(material),
-                                                      *(typeof(a) for a in arrays), types.int64))
+    arrays = group_arrays.py_func(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
+    steps = steps_of.py_func(material, np.bool_(False))  # the product's are of the same type
+    return types.none(typeof(steps), typeof(rule), typeof(material), *(typeof(a) for a in arrays), types.int64)
+
+
+@njit(cache=True)
+def no_response(steps, rule, material, group, points, scratch, count):
+    """A stand-in of :func:`group_response`'s type that computes nothing: no nodal forces
+    (group.fe, group.ge zero), the stresses and stretches left as they are. The loops
+    compile around it while the response compiles in a second process
+    (:mod:`shellsim.compile_beside`)."""
+    group.fe[:] = 0.0
+    group.ge[:] = 0.0
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -13,10 +13,11 @@ import numpy as np
 from ..bundles import Fields, Shape
 from ..element.assembly import StiffnessProduct
 from ..element.masses import lumped_masses
-from ..element.response import response_by_address
+from ..element.response import group_response, no_response, response_signature
 from ..element.sampling import point_tensors
 from ..element.static_loop import ElementLoop
 from ..compiled_call import TypedCall
+from ..compile_beside import CompiledBeside
 from ..errors import NumericalError
 from ..loads import add_masses
 from ..model import Model
@@ -68,8 +69,11 @@ class Simulation:
             prescribed_velocity=np.zeros(len(model.constraints.prescribed.nodes)), work=np.zeros(explicit.ENERGIES),
             energy=np.zeros(explicit.ENERGIES)))
         self.workspace = explicit.workspace(model)
+        # on an empty cache the response compiles in a second process while this one
+        # compiles the masses and the loops around a stand-in of its type
+        response = CompiledBeside(group_response, no_response, response_signature(model.rule, model.material))
         #: the element response, called by its address from every compiled element loop
-        self.response = response_by_address(model.rule, model.material)
+        self.response = response.held
         self.compiled = Compiled(advance=TypedCall(explicit.advance), masses=TypedCall(lumped_masses),
                                  stiffness=StiffnessProduct(self.response),
                                  applied_forces=TypedCall(explicit.applied_forces))
@@ -79,7 +83,10 @@ class Simulation:
         self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
         self.threads = ThreadChooser(limit_to_usable_cpus())
         self.mass_factor = 1.0  # every mass scaled by it (mass scaling)
-        self.update_masses()
+        with response.alongside():
+            self.update_masses()
+            if response.pending:
+                self.evaluate_forces()  # the stand-in's (no internal forces): the loops compile
         self.evaluate_forces()
 
     def update_masses(self) -> None:

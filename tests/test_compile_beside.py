@@ -1,7 +1,7 @@
 """The element response compiled by a second process on a first run: the cache's saves
 under a lock, the function loaded here from what the other process saved (not compiled
-again), a failed process leaving it to compile here, and a simulation built that way
-giving the same forces to the bit."""
+again), a failed process leaving it to compile here, a failed run stopping it, and a
+simulation built that way giving the same forces to the bit."""
 
 from __future__ import annotations
 
@@ -14,9 +14,10 @@ import sys
 
 import numpy as np
 import pytest
-from numba import typeof
+from numba import njit, typeof, types
 from numba.core import caching
 
+from shellsim.array_copy import copy_into
 from shellsim.cache_lock import LOCK_FILE, lock_cache_saves
 from shellsim.compile_beside import CompiledBeside
 from shellsim.element.response import group_arrays, response_signature
@@ -148,3 +149,14 @@ def test_the_response_signature_made_in_python_has_the_compiled_functions_types(
     arrays = group_arrays(rule.N.shape[0], len(rule.tz), len(rule.wq), rule.vol_basis.shape[1])
     assert signature.args[3:6] == tuple(typeof(a) for a in arrays)
     assert signature.args[0] == typeof(steps_of(model.material, np.bool_(False)))
+
+
+def test_work_that_fails_meanwhile_stops_the_second_process():
+    """A run that fails while the response compiles beside (a bad mesh, an interrupt) ends
+    with no process left compiling behind it."""
+    signature = types.none(types.float64[::1], types.float64[::1])
+    beside = CompiledBeside(copy_into, njit(lambda a, b: None), signature, beside=True)
+    with pytest.raises(RuntimeError, match="the model broke"):
+        with beside.alongside():
+            raise RuntimeError("the model broke")
+    assert beside._process.poll() is not None and beside.pending

@@ -56,27 +56,23 @@ class CompiledBeside:
         """The block runs while the second process compiles; after it, the function is held
         in the stand-in's place: loaded from the cache, or compiled here if the process
         failed. The wait is told as the function's compiling (the ``numba:compile`` event
-        :mod:`shellsim.compile_watch` hears). A block that raises stops the process."""
+        :mod:`shellsim.compile_watch` hears). A block or a wait that raises (an interrupt)
+        stops the process."""
         try:
             yield
+            if self._process is not None:
+                data = {"dispatcher": self.dispatcher, "args": self.signature.args,
+                        "return_type": self.signature.return_type}
+                with event.trigger_event("numba:compile", data=data):
+                    self._process.wait()
         except BaseException:
             if self._process is not None:
                 self._process.kill()
                 self._process.wait()
             raise
-        if not self.pending:
-            return
-        if self._process is not None:
-            data = {"dispatcher": self.dispatcher, "args": self.signature.args,
-                    "return_type": self.signature.return_type}
-            with event.trigger_event("numba:compile", data=data):
-                try:
-                    self._process.wait()
-                except BaseException:  # an interrupt: the process goes too
-                    self._process.kill()
-                    raise
-        hold_instead(self.held, self.dispatcher, self.signature)
-        self.pending = False
+        if self.pending:
+            hold_instead(self.held, self.dispatcher, self.signature)
+            self.pending = False
 
 
 def _cached(dispatcher, signature) -> bool:

@@ -38,19 +38,22 @@ def held_by_address(dispatcher, signature) -> List:
     caller, whose compiling then optimises and emits the callee's whole code once more.
     The holder is a typed list of one: a first-class function handed over from Python
     is looked up on every call (about 0.1 ms), a typed list only once, here."""
-    function_type = types.FunctionType(signature)
-    _hold.compile((function_type,))  # or loads it from the cache
-    return _hold.overloads[(function_type,)].entry_point(dispatcher)
+    return _entry_point(_hold, (types.FunctionType(signature),))(dispatcher)
 
 
 def hold_instead(held: List, dispatcher, signature) -> None:
     """Put ``dispatcher``, compiled for ``signature`` (or loaded from the cache), in the
     holder ``held`` (:func:`held_by_address`, the same signature) in place of the function
     it holds: the callers given the holder call it from then on."""
-    function_type = types.FunctionType(signature)
-    argument_types = (typeof(held), function_type)
-    _put.compile(argument_types)  # or loads it from the cache
-    _put.overloads[argument_types].entry_point(held, dispatcher)
+    _entry_point(_put, (typeof(held), types.FunctionType(signature)))(held, dispatcher)
+
+
+def _entry_point(dispatcher, argument_types):
+    """The code of ``dispatcher`` compiled for exactly ``argument_types`` (or loaded from
+    the cache), called without numba's typing: a function handed over as the function type
+    it is converted to, not as its own dispatcher's type."""
+    dispatcher.compile(argument_types)
+    return dispatcher.overloads[argument_types].entry_point
 
 
 @njit(cache=True)

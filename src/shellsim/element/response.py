@@ -182,7 +182,9 @@ def response_by_address(rule, material):
     held for calls through its address (:func:`shellsim.compiled_call.held_by_address`:
     the loops call ``response[0](...)``). Each loop that named it would link the whole
     element path into its own code and optimise and emit it again: seconds of a first run
-    for each of the static entry, the time loop and the parallel loop's layers."""
+    for each of the static entry, the time loop and the parallel loop's layers. Compiled
+    (or loaded) here at once; a :class:`~shellsim.solver.simulation.Simulation` holds its
+    own, compiled by a second process on an empty cache (:mod:`shellsim.compile_beside`)."""
     return held_by_address(group_response, response_signature(rule, material))
 
 

@@ -52,7 +52,7 @@ def pytest_configure(config):
 
         start = time.perf_counter()
         compiled = []
-        note = "compiling the kernels of three scenes, once for this version: about 2 minutes on 2 idle cores"
+        note = "compiling the kernels of three scenes, once for this version: about a minute and a half on 2 idle cores"
         with watching_compiles(lambda name: compiled or print(note, flush=True),
                                lambda name, seconds: compiled.append(name)):
             warm_numba_cache()

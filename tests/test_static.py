@@ -213,7 +213,7 @@ def test_tangent_at_rest_is_the_stiffness_product(path):
     vu = np.einsum("nij,nj->ni", eq.unknowns.frames, local[:, :3])
     f, fr = np.zeros_like(vu), np.zeros((model.n_nodes, 2))
     run.sim.compiled.stiffness(model.structure, s.fields.shape, s.stress, vu, np.ascontiguousarray(local[:, 3:]), f, fr,
-                       run.sim.workspace.parts)
+                               run.sim.workspace.parts)
     product = eq.unknowns.gather(eq.unknowns.to_local(f, fr))[:eq.unknowns.n_free]
     assert np.linalg.norm(k @ v - product) <= 1e-6 * np.linalg.norm(product)
 

@@ -4,18 +4,25 @@ number, as the run that never stopped; and what cannot be resumed says why."""
 
 from __future__ import annotations
 
+import json
+import os
+import pickle
+import shutil
 from pathlib import Path
 
 import meshio
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from shellsim.cli import app
 from shellsim.deck import load_deck
 from shellsim.deck.resolved import RESOLVED_NAME, read_resolved
-from shellsim.execute import run_scene
-from shellsim.output.checkpoint import CHECKPOINT_NAME, read_checkpoint
+from shellsim.errors import OutputError
+from shellsim.execute import built_run, run_scene
+from shellsim.output.checkpoint import CHECKPOINT_NAME, read_checkpoint, restore
 from shellsim.solver.run import Listener
 
 from .conftest import ROOT, deck_text, pressed_plates_deck, problems_of
@@ -120,3 +127,128 @@ def test_resume_from_the_command_line_and_what_it_refuses(tmp_path):
     static = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace(
         "[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0')
     assert "checkpoints are of the explicit time loop" in problems_of(static + "\n[output]\ncheckpoint_interval = 0.5\n")
+
+
+@pytest.fixture(scope="module")
+def stopped_cantilever(tmp_path_factory) -> Path:
+    """The cantilever's folder, its run stopped at 0.03 s with a checkpoint written."""
+    tmp_path = tmp_path_factory.mktemp("stopped")
+    deck_path = _cantilever(tmp_path, "test02_cantilever_uniform_load_3.toml")
+    folder = tmp_path / "run"
+    folder.mkdir()
+    run_scene(load_deck(deck_path), deck_path, folder, StopAt(0.03))
+    return folder
+
+
+class Planted:
+    """A pickle that, if ever unpickled, leaves a file behind."""
+
+    def __init__(self, marker: Path):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (Path.touch, (self.marker,))
+
+
+def _resume(folder: Path):
+    return CliRunner().invoke(app, ["run", "--resume", str(folder), "--quiet"])
+
+
+def test_a_checkpoint_cannot_run_code(stopped_cantilever, tmp_path):
+    """A pickle planted as an older checkpoint.pkl, and one inside the npz archive (an
+    object array), are never unpickled: nothing they carry runs, and the resume is refused
+    naming why."""
+    folder = tmp_path / "shared"
+    shutil.copytree(stopped_cantilever, folder)
+    marker = tmp_path / "ran"
+    (folder / CHECKPOINT_NAME).unlink()
+    (folder / "checkpoint.pkl").write_bytes(pickle.dumps(Planted(marker)))
+    result = _resume(folder)
+    assert result.exit_code == 2 and "a pickle can run code" in " ".join(result.output.split())
+    assert not marker.exists()
+    np.savez(folder / CHECKPOINT_NAME, document=np.array([Planted(marker)], dtype=object))
+    result = _resume(folder)
+    assert result.exit_code == 2 and "is not a checkpoint shellsim reads" in " ".join(result.output.split())
+    assert not marker.exists()
+
+
+def _document(folder: Path) -> dict:
+    with np.load(folder / CHECKPOINT_NAME) as archive:
+        return json.loads(bytes(archive["document"]).decode())
+
+
+def _rewrite(folder: Path, document: dict) -> None:
+    with np.load(folder / CHECKPOINT_NAME) as archive:
+        arrays = {name: archive[name] for name in archive.files if name != "document"}
+    np.savez(folder / CHECKPOINT_NAME, **arrays, document=np.frombuffer(json.dumps(document).encode(), np.uint8))
+
+
+def test_a_checkpoint_of_another_version_or_deck_is_refused_saying_why(stopped_cantilever, tmp_path):
+    """Written by another version, or beside a deck.toml edited since (its load doubled):
+    refused with the reason, the folder's files as they were; a FIFO at the checkpoint's
+    name is refused at once, not waited on."""
+    folder = tmp_path / "shared"
+    shutil.copytree(stopped_cantilever, folder)
+    document = _document(folder)
+    document["$dict"]["version"] = "0.0.1"
+    _rewrite(folder, document)
+    history = (folder / "history.csv").read_bytes()
+    result = _resume(folder)
+    assert result.exit_code == 2 and "written by shellsim 0.0.1" in " ".join(result.output.split())
+    shutil.copy(stopped_cantilever / CHECKPOINT_NAME, folder / CHECKPOINT_NAME)
+    deck = (folder / RESOLVED_NAME).read_text()
+    assert "value = -2.85" in deck
+    (folder / RESOLVED_NAME).write_text(deck.replace("value = -2.85", "value = -5.7"))
+    result = _resume(folder)
+    assert result.exit_code == 2 and "of another scene" in " ".join(result.output.split())
+    assert (folder / "history.csv").read_bytes() == history
+    (folder / CHECKPOINT_NAME).unlink()
+    os.mkfifo(folder / CHECKPOINT_NAME)
+    result = _resume(folder)
+    assert result.exit_code == 2 and "not a regular file" in " ".join(result.output.split())
+
+
+#: JSON values a damaged or forged document may hold where the checkpoint had another.
+JSON_VALUES = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=5),
+                           lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=6), inner,
+                                                                                        max_size=3), max_leaves=8)
+
+
+def _places(data, path=()):
+    """Every place in a JSON document: the keys and indices leading to it."""
+    yield path
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, list) else ()
+    for key, item in items:
+        yield from _places(item, (*path, key))
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_a_damaged_checkpoint_is_restored_or_refused_never_a_traceback(stopped_cantilever, built_cantilever,
+                                                                       tmp_path, data):
+    """Any one entry of the checkpoint's document removed or replaced by any JSON value:
+    read and restored into the run, or refused with an OutputError; nothing else."""
+    document = _document(stopped_cantilever)
+    places = [p for p in _places(document) if p]
+    path = data.draw(st.sampled_from(places))
+    parent = document
+    for key in path[:-1]:
+        parent = parent[key]
+    if data.draw(st.booleans()) and isinstance(parent, dict):
+        del parent[path[-1]]
+    else:
+        parent[path[-1]] = data.draw(JSON_VALUES)
+    folder = tmp_path / "damaged"
+    folder.mkdir(exist_ok=True)
+    shutil.copy(stopped_cantilever / CHECKPOINT_NAME, folder / CHECKPOINT_NAME)
+    _rewrite(folder, document)
+    try:
+        restore(built_cantilever, read_checkpoint(folder))
+    except OutputError:
+        pass
+
+
+@pytest.fixture(scope="module")
+def built_cantilever(stopped_cantilever):
+    """A run built from the stopped cantilever's resolved deck, not started."""
+    return built_run(read_resolved(stopped_cantilever), stopped_cantilever)

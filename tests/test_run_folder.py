@@ -72,14 +72,14 @@ def test_a_new_run_clears_what_an_earlier_run_left(tmp_path):
     folder = tmp_path / "run"
     (folder / "frames").mkdir(parents=True)
     (folder / "frames" / "results_0007.vtu").write_text("<VTKFile/>")
-    for name in ("results.pvd", "cables.xdmf", "cables.h5", "checkpoint.pkl"):
+    for name in ("results.pvd", "cables.xdmf", "cables.h5", "checkpoint.npz"):
         (folder / name).write_text("earlier")
     (folder / "summary.json").write_text(json.dumps({"status": "completed", "title": "an earlier scene"}))
     (folder / "notes.txt").write_text("the user's own")
     result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
     assert result.exit_code == 0, result.output
     left = {path.name for path in folder.iterdir()}
-    assert not left & {"frames", "results.pvd", "cables.xdmf", "cables.h5", "checkpoint.pkl"}
+    assert not left & {"frames", "results.pvd", "cables.xdmf", "cables.h5", "checkpoint.npz"}
     assert json.loads((folder / "summary.json").read_text())["title"] == "test scene"
     assert (folder / "notes.txt").read_text() == "the user's own"
 
@@ -111,9 +111,9 @@ def test_a_disk_that_fills_mid_run_stops_it_cleanly(small_disk):
     assert result.exit_code == 2 and "No space left on device" in " ".join(result.output.split())
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["status"] == "output failed" and "No space left on device" in summary["message"]
-    assert not list(folder.glob("*.partial"))
+    assert not list(folder.glob("*.partial*"))
     reader = meshio.xdmf.TimeSeriesReader(folder / "results.xdmf")
     reader.read_points_cells()
     assert 10 < reader.num_steps == summary["frames"] < 241
     reader.read_data(reader.num_steps - 1)
-    assert (folder / "checkpoint.pkl").exists()
+    assert (folder / "checkpoint.npz").exists()

@@ -75,13 +75,13 @@ def solve(run: Run, listener: Listener | None = None) -> Run:
 def _run_files() -> tuple[str, ...]:
     """The files and folders a run writes into its folder, renders included."""
     from .deck.resolved import RESOLVED_NAME
-    from .output.checkpoint import CHECKPOINT_NAME
+    from .output.checkpoint import CHECKPOINT_NAME, PICKLED_NAME
     from .output.render import RENDERS_DIR
     from .output.series import CABLES
     from .output.vtu import FRAMES_DIR
 
     series = tuple(f"{name}.{kind}" for name in ("results", CABLES) for kind in ("xdmf", "h5", "pvd"))
-    return (RESOLVED_NAME, "history.csv", "summary.json", CHECKPOINT_NAME, RENDERS_DIR, FRAMES_DIR,
+    return (RESOLVED_NAME, "history.csv", "summary.json", CHECKPOINT_NAME, PICKLED_NAME, RENDERS_DIR, FRAMES_DIR,
             f"{CABLES}_{FRAMES_DIR}", *series)
 
 
@@ -146,6 +146,8 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
                 current.status, message = "output failed", str(error)
             finally:
                 files.close()
+                if frames.written > len(current.frame_times):  # in every series, though a checkpoint after it failed
+                    current.frame_times.append(current.sim.state.t)
                 result = summary(current, deck_path, plan(scene), message, writers.seconds)
                 write_json(result, folder / "summary.json")
     return current, result

@@ -20,7 +20,7 @@ from .material import MATERIALS, Material
 from ..materials.axes import CentrelineAxes, CylindricalAxes
 from ..loads import CABLE_TABLES, CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
-from ..table_types import Count, Name, NonNegative, Positive, Real, Section, Vec3, need_directions, repeated
+from ..table_types import Count, Line, Name, NonNegative, Positive, Real, Section, Text, Vec3, need_directions, repeated
 
 Axis = Literal["x", "y", "z"]
 
@@ -41,10 +41,10 @@ class Meta(Section):
     """What the scene is. ``units`` names the unit system the deck's numbers are in, for
     printouts; nothing is converted."""
 
-    title: Annotated[str, Field(strict=True, min_length=1)]
+    title: Annotated[Line, Field(min_length=1)]
     units: Literal[tuple(SYSTEMS)] = "SI"
-    description: str = ""
-    source: str = ""
+    description: Text = ""
+    source: Text = ""
 
 
 class MeshOptions(Section):
@@ -502,7 +502,7 @@ class Output(Section):
     (pressures follow the stresses' unit unless given; the files keep the deck's units);
     ``vessel_axes`` are the axes ``vessel_stress`` reads the radial, hoop and axial
     stresses in (by default the material's, when they are a tube's or a centreline's);
-    ``checkpoint_interval`` (explicit runs) writes checkpoint.pkl at the first frame at or
+    ``checkpoint_interval`` (explicit runs) writes checkpoint.npz at the first frame at or
     after each multiple of it, which ``shellsim run --resume FOLDER`` goes on from, to the
     same answer; probes (history.csv), a valve's measures and renders."""
 

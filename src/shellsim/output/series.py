@@ -40,6 +40,7 @@ class FrameWriter(Listener):
         self.run = run
         self.cables = cable_mesh(run.model)
         self.encoding = Encoding.of(output)
+        self.written = kept or 0  # frames every series holds
         self.series, self.cable_series = [], []
         try:
             for kind in dict.fromkeys(output.formats):
@@ -77,6 +78,7 @@ class FrameWriter(Listener):
             except OSError as error:
                 raise OutputError(f"writing the frame at t = {t:.6g} to {series.path} failed: "
                                   f"{error.strerror or error}") from None
+        self.written += 1
 
     def close(self) -> None:
         for series in self.series + self.cable_series:

@@ -16,12 +16,12 @@ from typing import Annotated, Any
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
 
 from . import __version__
 from .errors import OutputError, SceneTooLarge, ShellsimError, Terminated
 from .output.folder import output_folder
+from .printable import shown
 from .signals import handling
 from .solver.stability import describe
 
@@ -67,7 +67,7 @@ def reports_errors(command: Callable[..., Any]) -> Callable[..., Any]:
             with sigterm_as_interrupt(received):
                 return command(*args, **kwargs)
         except ShellsimError as error:
-            err.print(f"[bold red]error:[/] {escape(str(error))}", highlight=False, markup=True, soft_wrap=True)
+            err.print(f"[bold red]error:[/] {shown(str(error))}", highlight=False, markup=True, soft_wrap=True)
             raise typer.Exit(EXIT_USER_ERROR) from None
         except KeyboardInterrupt:
             err.print("[yellow]terminated[/]" if received else "[yellow]interrupted[/]")
@@ -102,7 +102,7 @@ def check(deck: DeckPath) -> None:
     from .solver.outlook import refuse_if_hopeless, static_outlook, step_outlook
 
     scene = load_deck(deck)
-    mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{escape(text)}[/]", highlight=False))
+    mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{shown(text)}[/]", highlight=False))
     static = scene.solver.method == "static"
     with err.status("building the model") as status, _compiles_shown(status):
         model = build_model(scene, mesh)
@@ -143,7 +143,7 @@ def _compiles_shown(status):
     def end(name: str, seconds: float) -> None:
         status.update(said.pop())
         if text := finished_text(name, seconds):
-            err.print(f"[dim]{escape(text)}[/]", highlight=False)
+            err.print(f"[dim]{shown(text)}[/]", highlight=False)
 
     return watching_compiles(start, end)
 
@@ -162,7 +162,7 @@ def mesh(
 
     scene = load_deck(deck)
     folder = output_folder(out_dir)
-    err.print(f"meshing {escape(str(deck))}", highlight=False)
+    err.print(f"meshing {shown(str(deck))}", highlight=False)
     built = build_mesh(scene, deck.parent)
     write_mesh_vtu(built, folder / "mesh.vtu")
     written = [folder / "mesh.vtu"]
@@ -172,7 +172,7 @@ def mesh(
         render_mesh(built, folder / "mesh.png")
         written.append(folder / "mesh.png")
     sets = ", ".join(f"{name} ({s.kind}, {len(s.nodes)})" for name, s in sorted(built.sets.items()))
-    out.print(f"{escape(scene.meta.title)}: {built.n_elements} elements, {built.n_nodes} nodes, "
+    out.print(f"{shown(scene.meta.title)}: {built.n_elements} elements, {built.n_nodes} nodes, "
               f"{5 * built.n_nodes} DOFs")
     out.print(f"sets: {sets}", highlight=False)
     _announce(written)
@@ -196,17 +196,17 @@ def import_model(
         done = bring_over(model, folder)
     sets = ", ".join(f"{name} ({kind})" for name, kind in sorted(done.sets.items()))
     cables = f", {done.cables} cable elements" if done.cables else ""
-    out.print(f"{escape(str(model))}: {done.elements} elements{cables}; sets: {escape(sets) or 'none'}",
+    out.print(f"{shown(str(model))}: {done.elements} elements{cables}; sets: {shown(sets) or 'none'}",
               highlight=False)
     if done.unmapped:
         err.print("[yellow]not brought over[/] (listed at the top of the deck too):")
         for line in done.unmapped:
-            err.print(f"  - {escape(line)}", highlight=False)
+            err.print(f"  - {shown(line)}", highlight=False)
     _announce([done.deck, done.mesh])
     if done.problems:
         err.print(f"[yellow]{done.deck} needs editing before it runs:[/]")
         for line in done.problems:
-            err.print(f"  - {escape(line)}", highlight=False)
+            err.print(f"  - {shown(line)}", highlight=False)
     else:
         out.print(f"[green]ok[/] shellsim check {done.deck}; shellsim run {done.deck}")
 
@@ -278,7 +278,7 @@ def run(
     if not quiet:
         out.print(_run_report(result, folder))
     if current.status in ("unstable", "not converged"):
-        err.print(f"[bold red]error:[/] {escape(message)}", highlight=False)
+        err.print(f"[bold red]error:[/] {shown(message)}", highlight=False)
         raise typer.Exit(EXIT_UNSTABLE)
     if not all(r["passed"] for r in result["reference"]):
         raise typer.Exit(EXIT_REFERENCE_FAILED)
@@ -296,12 +296,12 @@ def _run_report(result: dict, folder: Path) -> Table | str:
                 f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
                 f"{e['balance_error_percent']:+.3f}%")
                + (f", volume change {result['volume_change_percent']:+.3f}%" if "volume_change_percent" in result else "")
-               + f"; results in {escape(str(folder))}")
-    title = f"{escape(result['title'])}: {result['status']}"
-    passed = [escape(describe(event)) for event in (static or {}).get("stability", [])]
+               + f"; results in {shown(str(folder))}")
+    title = f"{shown(result['title'])}: {result['status']}"
+    passed = [shown(describe(event)) for event in (static or {}).get("stability", [])]
     if not result["reference"]:
         return "\n".join([title, *passed, caption])
-    notes = [*passed, *(escape(f"{r['quantity']}: {r['note']}") for r in result["reference"] if "note" in r)]
+    notes = [*passed, *(shown(f"{r['quantity']}: {r['note']}") for r in result["reference"] if "note" in r)]
     table = Table(title=title, title_justify="left", caption="\n".join([*notes, caption]))
     for column in ("quantity", "computed", "expected", "error", "tolerance", "ok"):
         table.add_column(column)
@@ -309,8 +309,9 @@ def _run_report(result: dict, folder: Path) -> Table | str:
         tolerance = f"{r['tolerance_percent']}%" if r["tolerance"] is None else f"{r['tolerance']}"
         error = "-" if r["computed"] is None else (
             f"{r['error_percent']:+.3f}%" if r["error_percent"] is not None else f"{r['error']:+.4g}")
-        table.add_row(escape(r["quantity"]), "-" if r["computed"] is None else f"{r['computed']:.6g}",
-                      f"{r['expected']:.6g}", error, tolerance, "[green]yes" if r["passed"] else "[red]no")
+        table.add_row(shown(r["quantity"]), "-" if r["computed"] is None else f"{r['computed']:.6g}",
+                      f"{r['expected']:.6g}", error, tolerance,
+                      {True: "[green]yes", False: "[red]no", None: "-"}[r["passed"]])
     return table
 
 
@@ -521,12 +522,12 @@ THIN_SHELL_GAIN = 2.0
 def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     from .solver.outlook import duration, size_text
 
-    table = Table(title=escape(scene.meta.title), show_header=False, title_justify="left")
+    table = Table(title=shown(scene.meta.title), show_header=False, title_justify="left")
     table.add_column(style="bold")
     table.add_column()
 
     def row(label: str, text: str) -> None:  # deck text is shown as written, never read as markup
-        table.add_row(label, escape(text))
+        table.add_row(label, shown(text))
 
     g = scene.geometry
     params = ", ".join(f"{k}={v}" for k, v in g.model_dump().items() if k != "builder")

@@ -4,6 +4,7 @@ deck's header listing what was not brought over, the deck checked as ``check`` w
 from __future__ import annotations
 
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -13,6 +14,7 @@ from .errors import DeckError, OutputError, ShellsimError
 from .foreign import read_foreign
 from .mesh import Mesh
 from .output.folder import output_folder, write_atomically
+from .printable import printable
 
 DECK_NAME = "deck.toml"
 #: The deck's tables in the order a reader expects them.
@@ -68,19 +70,29 @@ def deck_text(tables: dict) -> str:
         if isinstance(value, list):
             blocks += [f"[[{key}]]\n" + _keys(item) for item in value]
         elif key == "curves":
-            blocks += [f"[curves.{name}]\n" + _keys(curve) for name, curve in value.items()]
+            blocks += [f"[curves.{_key(name)}]\n" + _keys(curve) for name, curve in value.items()]
         else:
             blocks.append(f"[{key}]\n" + _keys(value))
     return "\n".join(blocks)
 
 
+def _key(name: str) -> str:
+    """``name`` as a TOML key: bare where it may be, else a quoted string."""
+    return name if re.fullmatch(r"[A-Za-z0-9_\-]+", name) else _string(name)
+
+
+def _string(text: str) -> str:
+    """``text`` as a TOML basic string: JSON's escapes, and DEL's, which JSON leaves bare."""
+    return json.dumps(text).replace("\x7f", "\\u007f")
+
+
 def _keys(table: dict) -> str:
-    return "".join(f"{key} = {_inline(value)}\n" for key, value in table.items())
+    return "".join(f"{_key(key)} = {_inline(value)}\n" for key, value in table.items())
 
 
 def _inline(value) -> str:
     if isinstance(value, dict):
-        return "{ " + ", ".join(f"{key} = {_inline(v)}" for key, v in value.items()) + " }"
+        return "{ " + ", ".join(f"{_key(key)} = {_inline(v)}" for key, v in value.items()) + " }"
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(_inline(v) for v in value) + "]"
     if isinstance(value, bool):
@@ -89,14 +101,16 @@ def _inline(value) -> str:
         return repr(float(value))
     if isinstance(value, (int, np.integer)):
         return str(int(value))
-    return json.dumps(str(value))  # a JSON string is a TOML basic string
+    return _string(str(value))
 
 
 def _header(source: Path, unmapped: list[str]) -> str:
-    lines = [f"# Brought over from {source.name} by `shellsim import`."]
+    """The deck's opening comments; what they quote of the file is one line each
+    (:func:`printable`), so no text of the file's can start a table."""
+    lines = [f"# Brought over from {printable(source.name)} by `shellsim import`."]
     if unmapped:
         lines += ["# Not brought over (state these in the deck where the scene needs them):"]
-        lines += [f"#   - {line}" for line in unmapped]
+        lines += [f"#   - {printable(line)}" for line in unmapped]
     return "\n".join(lines) + "\n\n"
 
 

@@ -8,6 +8,8 @@ from typing import Annotated
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+from .printable import control_characters
+
 #: The magnitudes a deck's numbers may have. Products of a few of them (a stiffness E h^3,
 #: a frequency E / (rho L^2), an energy) must stay far inside double precision, and no
 #: unit system puts a physical quantity of a shell model outside this range.
@@ -29,6 +31,25 @@ Count = Annotated[int, Field(strict=True, ge=1)]
 Vec3 = tuple[Real, Real, Real]
 #: Names of sets, curves and probes: a letter first, then letters, digits, '_' or '-'.
 Name = Annotated[str, Field(strict=True, pattern=r"^[A-Za-z][A-Za-z0-9_\-]*$")]
+
+
+def _text_without(allowed: str):
+    """A validator refusing control characters other than ``allowed`` (they would act on
+    the terminal the text is printed on)."""
+
+    def check(text: str) -> str:
+        found = control_characters(text, allowed)
+        if found:
+            raise ValueError(f"holds the control character(s) {', '.join(found)}; write the text without them")
+        return text
+
+    return AfterValidator(check)
+
+
+#: One line of free text (a title): no control characters.
+Line = Annotated[str, Field(strict=True), _text_without("")]
+#: Free text (a description): no control characters but line breaks and tabs.
+Text = Annotated[str, Field(strict=True), _text_without("\n\t")]
 
 
 def need_directions(table: BaseModel, *keys: str) -> None:

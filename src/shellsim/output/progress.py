@@ -8,11 +8,11 @@ from __future__ import annotations
 import time
 
 from rich.console import Console
-from rich.markup import escape
 from rich.progress import BarColumn, Progress, ProgressColumn, TextColumn, TimeRemainingColumn
 from rich.text import Text
 
 from ..compile_watch import FIRST_RUN_NOTE, finished_text
+from ..printable import shown
 from ..solver.run import Listener, Run
 
 
@@ -57,7 +57,7 @@ class ProgressDisplay(Listener):
     def announce(self, text: str) -> None:
         """A stage of the work before the first step (meshing, the mesh's size, building)."""
         if not self.quiet:
-            self.console.print(f"[dim]{escape(text)}[/]", highlight=False)
+            self.console.print(f"[dim]{shown(text)}[/]", highlight=False)
 
     def compiling(self, name: str) -> None:
         """A kernel begins to compile (:mod:`shellsim.compile_watch`): named on the bar, its

@@ -45,12 +45,15 @@ class Keyword:
 def read_keywords(path: Path) -> list[Keyword]:
     """Every keyword of the input file ``path`` in order, ``*INCLUDE`` files spliced in.
 
-    Raises MeshError for a file that cannot be read or holds data before its first keyword.
+    Raises MeshError for a file that cannot be read or holds data before its first
+    keyword, and for an included file outside ``path``'s folder (links followed): a model
+    from someone else must not read the user's other files, nor quote them in a message.
     """
-    return _read(Path(path), seen=())
+    path = Path(path)
+    return _read(path, seen=(), root=path.parent.resolve())
 
 
-def _read(path: Path, seen: tuple[Path, ...]) -> list[Keyword]:
+def _read(path: Path, seen: tuple[Path, ...], root: Path) -> list[Keyword]:
     from . import check_model_file
 
     check_model_file(path)
@@ -74,15 +77,20 @@ def _read(path: Path, seen: tuple[Path, ...]) -> list[Keyword]:
                 included = keyword.param("input")
                 if not included:
                     raise MeshError(f"{keyword.label()}: INPUT= names no file")
+                target = path.parent / included.strip('"')
+                if not target.resolve().is_relative_to(root):
+                    raise MeshError(f"{keyword.label()}: the included file '{included}' lies outside the model's "
+                                    f"folder '{root}'; shellsim reads included files only there (copy it in)")
                 try:
-                    keywords.extend(_read(path.parent / included.strip('"'), seen + (resolved,)))
+                    keywords.extend(_read(target, seen + (resolved,), root))
                 except MeshError as error:
                     raise MeshError(f"{keyword.label()}: {error}") from None
             else:
                 keywords.append(keyword)
             continue
         if not keywords:
-            raise MeshError(f"input file '{path}', line {number}: data before the first keyword: '{line[:60]}'")
+            raise MeshError(f"input file '{path}', line {number}: data before the first keyword (is it an input "
+                            "file?)")
         current = keywords[-1]
         if pending:
             line, pending = pending + line, ""

@@ -1,12 +1,21 @@
 """Output folders, created and proven writable before any work is done, held by one run
 at a time and cleared of an earlier run's files, and files replaced atomically in them (a
-reader never sees half a file)."""
+reader never sees half a file).
+
+Output folders get shared, and a link left in one must not make shellsim write outside
+it: every file is written under a new name of its own (created exclusively, so never
+through a link) and renamed over its place, which replaces a link there instead of
+following it; a file appended to, a subfolder and the lock are refused when a link
+stands at their name.
+"""
 
 from __future__ import annotations
 
+import functools
 import os
 import shutil
 import sys
+import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -18,23 +27,72 @@ def output_folder(path: Path) -> Path:
     """Create ``path`` and prove it writable before any work is done."""
     try:
         path.mkdir(parents=True, exist_ok=True)
-        probe = path / ".shellsim-write-test"
-        probe.write_bytes(b"")
-        probe.unlink()
+        handle, probe = tempfile.mkstemp(prefix=".shellsim-write-test", dir=path)
+        os.close(handle)
+        os.unlink(probe)
     except OSError as error:
         raise OutputError(f"output folder '{path}' is not writable: {error.strerror or error}") from None
     return path
 
 
-def write_atomically(path: Path, data: str | bytes) -> None:
-    """Write ``data`` (text as UTF-8) to ``path`` through a partial file renamed over it."""
-    partial = path.with_name(path.name + ".partial")
+@functools.cache
+def _umask() -> int:
+    """The process's umask (read by setting it, and set back at once)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def refuse_link(path: Path) -> Path:
+    """``path``; OutputError when a symbolic link stands at its name (shellsim writes
+    nothing through one)."""
+    if path.is_symlink():
+        raise OutputError(f"'{path}' is a symbolic link: shellsim writes nothing through a link in an output folder; "
+                          "remove it, or write to another folder (--out)")
+    return path
+
+
+def open_unlinked(path: Path, mode: str, **options):
+    """``open(path, mode, **options)``, refused (OutputError) where a link stands at its
+    name, and opened without following one that appears there meanwhile."""
+    return open(refuse_link(path), mode, opener=lambda name, flags: os.open(name, flags | os.O_NOFOLLOW, 0o666),
+                **options)
+
+
+def subfolder(folder: Path, name: str) -> Path:
+    """``folder / name`` made a folder if it is none yet; OutputError for a link there."""
+    path = refuse_link(folder / name)
     try:
-        partial.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
+        path.mkdir(exist_ok=True)
+    except OSError as error:
+        raise OutputError(f"cannot make the folder '{path}': {error.strerror or error}") from None
+    return path
+
+
+@contextmanager
+def replacing(path: Path) -> Iterator[Path]:
+    """A new file of its own beside ``path`` (its suffix kept, for writers that go by
+    it) for the body to write, renamed over ``path`` when the body ends, removed when it
+    raises. OutputError when it cannot be made or renamed."""
+    try:
+        handle, partial = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".partial{path.suffix}", dir=path.parent)
+        os.close(handle)
+        os.chmod(partial, 0o666 & ~_umask())  # as a file opened for writing would be, not mkstemp's 0600
+    except OSError as error:
+        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+    try:
+        yield Path(partial)
         os.replace(partial, path)
     except OSError as error:
-        partial.unlink(missing_ok=True)  # on a full disk, the room it took is the summary's
         raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+    finally:
+        Path(partial).unlink(missing_ok=True)  # on a full disk, the room it took is the summary's
+
+
+def write_atomically(path: Path, data: str | bytes) -> None:
+    """Write ``data`` (text as UTF-8) to ``path`` through a new file renamed over it."""
+    with replacing(path) as partial:
+        partial.write_bytes(data.encode("utf-8") if isinstance(data, str) else data)
 
 
 #: The file in a run's folder that a run holds locked while it writes there.
@@ -60,7 +118,7 @@ def claimed(folder: Path) -> Iterator[None]:
         yield
         return
     try:
-        lock = open(folder / LOCK_NAME, "a+", encoding="utf-8")
+        lock = open_unlinked(folder / LOCK_NAME, "a+", encoding="utf-8")
     except OSError as error:
         raise OutputError(f"cannot lock the output folder '{folder}': {error.strerror or error}") from None
     with lock:

@@ -8,13 +8,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..deck.references import ENERGY_COLUMNS
 from ..errors import OutputError
 from ..solver.explicit import FRICTION
 from ..solver.run import Listener, Run
+from .folder import open_unlinked
 
-#: The energies' columns, in the order of :mod:`shellsim.solver.explicit`'s indices; the
-#: last, friction's, only where a contact has friction.
-ENERGY_COLUMNS = ("internal_energy", "kinetic_energy", "external_work", "damping_work", "friction_work")
 
 
 def energy_columns(run: Run) -> tuple[str, ...]:
@@ -33,7 +32,7 @@ class HistoryWriter(Listener):
             if kept:
                 with open(path, newline="", encoding="utf-8") as written:  # its rows' own line ends
                     earlier = written.readlines()[:kept + 1]
-            self._file = open(path, "w", newline="", encoding="utf-8")
+            self._file = open_unlinked(path, "w", newline="", encoding="utf-8")  # truncated in place
             self._file.writelines(earlier)
         except OSError as error:
             raise OutputError(f"cannot write '{path}': {error.strerror}") from None

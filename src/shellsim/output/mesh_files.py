@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import OutputError
+from .folder import replacing
 from ..geometry.importing import CABLE_MARK, KIND_CODE, SET_PREFIX
 from ..mesh import Mesh
 
@@ -41,10 +41,8 @@ def write_mesh_vtu(mesh: Mesh, path: Path, with_thickness: bool = True) -> None:
         cell_data = {name: [_or_zeros(shells.get(name), cables.get(name), mesh.n_elements),
                             _or_zeros(cables.get(name), shells.get(name), len(mesh.lines))]
                      for name in shells | cables}
-    try:
-        meshio.write(path, meshio.Mesh(mesh.x, blocks, point_data=point_data, cell_data=cell_data), file_format="vtu")
-    except OSError as err:
-        raise OutputError(f"cannot write '{path}': {err.strerror or err}") from None
+    with replacing(path) as partial:
+        meshio.write(partial, meshio.Mesh(mesh.x, blocks, point_data=point_data, cell_data=cell_data), file_format="vtu")
 
 
 def _or_zeros(values: np.ndarray | None, other: np.ndarray, count: int) -> np.ndarray:

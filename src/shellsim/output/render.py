@@ -14,7 +14,7 @@ from ..deck.schema import TENSOR_COMPONENTS, VECTOR_COMPONENTS
 from ..element.shape import shape
 from ..errors import OutputError, ShellsimError
 from .encoding import SYMMETRIC_PAIRS
-from .folder import output_folder
+from .folder import output_folder, refuse_link, replacing
 from .units import NODAL_SUFFIX, DisplayUnits
 from ..mesh import Mesh
 
@@ -105,8 +105,11 @@ def render_mesh(mesh: Mesh, path: Path, size: tuple[int, int] = (1200, 900)) -> 
         plotter.add_legend(legend, bcolor="white", face="circle", loc="upper left",
                            size=(0.22, min(0.9, 0.035 * len(legend) + 0.02)))
     _look(plotter, "auto", mesh.x)
-    plotter.screenshot(str(path))
-    plotter.close()
+    try:
+        with replacing(path) as partial:
+            plotter.screenshot(str(partial))
+    finally:
+        plotter.close()
 
 
 #: The outer ring of an element's 4 x 4 sub-cell corners (r fastest), closed.
@@ -210,7 +213,7 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
     label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
     bar = units.label(f"{label} {picked[0][2]}".strip(), field)
-    out_dir = output_folder(out_dir or folder / RENDERS_DIR)
+    out_dir = output_folder(out_dir or refuse_link(folder / RENDERS_DIR))
     stem = f"{field}{'_' + picked[0][2] if picked[0][2] else ''}_{view}"
     written = []
     if overlays.fibres and not any(map(is_fibre_direction, frames[0][1])):
@@ -233,7 +236,8 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
         import imageio.v3 as iio
 
         gif = out_dir / f"{stem}.gif"
-        iio.imwrite(gif, np.stack([iio.imread(p) for p in written]), duration=200, loop=0)
+        with replacing(gif) as partial:
+            iio.imwrite(partial, np.stack([iio.imread(p) for p in written]), duration=200, loop=0)
         written.append(gif)
     return written
 
@@ -309,6 +313,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
     plotter.add_text(caption, position="upper_left", font_size=max(8, size[1] // 70), color="black")
     _look(plotter, view, points)
     try:
-        plotter.screenshot(str(path))
+        with replacing(path) as partial:
+            plotter.screenshot(str(partial))
     finally:
         plotter.close()

@@ -8,7 +8,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from .encoding import Encoding
-from .folder import write_atomically
+from .folder import refuse_link, replacing, subfolder, write_atomically
 
 FRAMES_DIR = "frames"
 
@@ -27,7 +27,8 @@ class VtuSeries:
     def __init__(self, folder: Path, mesh, encoding: Encoding, name: str = "results", kept: int | None = None):
         self.name = name
         self.path = folder / f"{name}.pvd"
-        self.frames = folder / (FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}")
+        frames = FRAMES_DIR if name == "results" else f"{name}_{FRAMES_DIR}"
+        self.frames = refuse_link(folder / frames)
         self.mesh = mesh
         self.encoding = encoding
         self.entries: list[tuple[float, str]] = []
@@ -39,7 +40,7 @@ class VtuSeries:
             return
         if self.frames.exists():  # frames of an earlier run would be listed by nobody
             shutil.rmtree(self.frames)
-        self.frames.mkdir()
+        subfolder(folder, frames)
 
     def write(self, t: float, point_data: dict, cell_data: dict) -> None:
         """Add the frame at time ``t``: fields (P,) or (P, k) on the points, (C,) or (C, k)
@@ -48,11 +49,12 @@ class VtuSeries:
 
         floats = self.encoding.floats
         name = f"{self.frames.name}/{self.name}_{len(self.entries):04d}.vtu"
-        meshio.write(self.path.parent / name, meshio.Mesh(
-            floats(self.mesh.points), [(self.mesh.cell_type, self.mesh.cells)],
-            point_data={key: floats(values) for key, values in point_data.items()},
-            cell_data={key: [floats(values)] for key, values in cell_data.items()}),
-            file_format="vtu", compression="zlib" if self.encoding.compress else None)
+        with replacing(self.path.parent / name) as partial:
+            meshio.write(partial, meshio.Mesh(
+                floats(self.mesh.points), [(self.mesh.cell_type, self.mesh.cells)],
+                point_data={key: floats(values) for key, values in point_data.items()},
+                cell_data={key: [floats(values)] for key, values in cell_data.items()}),
+                file_format="vtu", compression="zlib" if self.encoding.compress else None)
         self.entries.append((float(t), name))
         root = ET.Element("VTKFile", type="Collection", version="0.1")
         collection = ET.SubElement(root, "Collection")

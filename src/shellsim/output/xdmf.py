@@ -17,7 +17,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from .encoding import Encoding
-from .folder import write_atomically
+from .folder import refuse_link, write_atomically
 
 #: XDMF's topology type and nodes per cell of each cell type written.
 TOPOLOGY = {"quad": ("Quadrilateral", 4), "hexahedron": ("Hexahedron", 8), "line": ("Polyline", 2)}
@@ -39,10 +39,10 @@ class XdmfSeries:
         self.encoding = encoding
         self._h5_name = f"{name}.h5"
         if kept is not None:
-            self._h5 = h5py.File(folder / self._h5_name, "a")
+            self._h5 = h5py.File(refuse_link(folder / self._h5_name), "a")
             self._go_on_after(kept)
             return
-        self._h5 = h5py.File(folder / self._h5_name, "w")
+        self._h5 = h5py.File(refuse_link(folder / self._h5_name), "w")
         topology_type, corners = TOPOLOGY[mesh.cell_type]
         self._topology = ET.Element("Topology", TopologyType=topology_type, NumberOfElements=str(len(mesh.cells)),
                                     NodesPerElement=str(corners))

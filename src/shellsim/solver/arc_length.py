@@ -98,7 +98,7 @@ class ArcLength:
         """The translational length of the linear response to ``load_step`` of load time at
         the converged state: the path's first step matches load control's first."""
         self.eq.evaluate(self.load_time)
-        _, lu, _ = self.newton.linearised()
+        _, lu, _ = self.newton.at_converged("at the start, where the path's first tangent is formed", record=False)
         along = lu.solve(self.rate(self.load_time))[self.translation]
         length = abs(load_step) * float(np.linalg.norm(along))
         self.load_per_length = abs(load_step) / max(length, 1e-300)
@@ -155,7 +155,8 @@ class ArcLength:
         eq, newton, m = self.eq, self.newton, self.translation
         start = t = self.load_time
         eq.evaluate(t)
-        _, lu, floor = newton.linearised(at_converged=True)
+        _, lu, floor = newton.at_converged(f"at load time {t:.6g} (clock t = {newton.run.sim.state.t:.6g}), where the "
+                                           "converged state's tangent is formed")
         rate = self.rate(t)
         along = lu.solve(rate)
         sign = 1.0 if self.direction is None or along[m] @ self.direction >= 0.0 else -1.0

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import NumericalError
+from ..errors import NumericalError, id_list, place
 from ..loads import passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
@@ -65,13 +65,15 @@ class NotConverged(Exception):
     """A load step that could not be solved, and why."""
 
 
-def _factorised(tangent):
-    """The sparse LU factors of ``tangent`` (square)."""
-    try:
-        lu = SymmetricPatternLU(tangent)
-    except RuntimeError as error:  # "Factor is exactly singular"
-        raise NotConverged(f"the tangent stiffness is singular ({error})") from None
-    return lu
+class SingularTangent(NotConverged):
+    """A tangent with no factors: formed at a converged state, no shorter step helps."""
+
+
+#: What to do about a tangent that is singular at a converged state.
+SINGULAR_ADVICE = ("A node held by nothing in some direction (a slack cable's free end or joint, a node on no "
+                   "element, a structure free to move as a whole) leaves the tangent singular where nothing is "
+                   "stretched yet: hold it, give its cables a prestretch, or solve the scene explicitly "
+                   "(solver.method = \"explicit\"), where its mass keeps it in place")
 
 
 class NewtonSolver:
@@ -109,19 +111,47 @@ class NewtonSolver:
     def linearised(self, at_converged: bool = False):
         """(tangent (n_free, size), the LU factors of its free columns, its round-off
         floor) at the last evaluation; ``at_converged``: the evaluation is of the converged
-        state, whose stability the factors' pivots are recorded as."""
+        state, whose stability the factors' pivots are recorded as. Raises
+        SingularTangent, naming the nodes with no stiffness, when it has no factors."""
         tangent = self.eq.tangent()
-        lu = _factorised(tangent[:, :self.n_free])
+        try:
+            lu = SymmetricPatternLU(tangent[:, :self.n_free])
+        except RuntimeError as error:  # "Factor is exactly singular"
+            raise SingularTangent(f"the tangent stiffness is singular ({error}){self._stiffless(tangent)}") from None
         if at_converged:
             self.stability.observe(self.eq.converged.t, self.run.load_time, lu.negative_pivots)
         return tangent, lu, self.round_off(tangent)
+
+    def _stiffless(self, tangent) -> str:
+        """The nodes a tangent (n_free, size) gives no stiffness in some free direction
+        (a zero diagonal), for a message: '; nodes 12, 13 (the first at (0, 1, 2)) have no
+        stiffness in some direction'; '' when there are none."""
+        diagonal = np.abs(tangent[:, :self.n_free].diagonal())
+        zero = diagonal <= 1e-14 * max(float(diagonal.max(initial=0.0)), 1e-300)
+        if not zero.any():
+            return ""
+        marked = self.eq.unknowns.scatter(np.concatenate([zero, np.zeros(self.eq.unknowns.n_known)]))
+        nodes = np.flatnonzero(marked.any(axis=1))
+        return (f"; {len(nodes)} node(s) have no stiffness in some direction: nodes {id_list(nodes + 1)} (the first at "
+                f"{place(self.run.mesh.x[nodes[0]])})")
+
+    def at_converged(self, where: str, record: bool = True):
+        """:meth:`linearised` at the converged state (its stability recorded unless not
+        ``record``), ``where`` saying which for a message; NumericalError, with what to do,
+        when it is singular: no shorter step gets past a tangent singular at the state
+        every step starts from."""
+        try:
+            return self.linearised(at_converged=record)
+        except SingularTangent as why:
+            raise NumericalError(not_converged(self.run, self, where, str(why), SINGULAR_ADVICE)) from None
 
     def observe(self) -> None:
         """Record the stability of the converged state: a tangent there, with its own load
         (a follower pressure's stiffness is the new load's at a step's first iterate), which
         modified Newton goes on with."""
         self.eq.evaluate(self.run.load_time)
-        self.tangent = self.linearised(at_converged=True)
+        self.tangent = self.at_converged(f"at load time {self.run.load_time:.6g}, where the converged state's tangent "
+                                         "is formed")
 
     def converged(self, norm: float, scale: float, energy: float, energy_scale: float, floor: float,
                   stalled: bool = False) -> bool:

@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -142,3 +143,48 @@ def test_a_stop_ends_gmsh_meshing_at_once(tmp_path, stop, code, word):
         process.communicate()
         pytest.fail("the meshing went on for a minute after the stop")
     assert process.returncode == code and word in stderr
+
+
+def _children(pid: int) -> list[int]:
+    """The processes ``pid`` started that are still its children (Linux's /proc)."""
+    return [int(c) for c in (Path("/proc") / str(pid) / "task" / str(pid) / "children").read_text().split()]
+
+
+def _gone(pid: int) -> bool:
+    """Whether process ``pid`` has ended (gone, or a zombie nobody has reaped yet)."""
+    try:
+        return (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0] in "ZX"
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="reads processes from Linux's /proc")
+def test_a_killed_shellsim_takes_its_gmsh_child_with_it(tmp_path):
+    """`shellsim mesh` of the carotid at 0.06 mm killed outright (SIGKILL, which it cannot
+    handle) while gmsh meshes in its child: the child is killed with it, not left meshing
+    on for minutes holding a core, its memory and its caller's pipes."""
+    deck = tmp_path / "fine.toml"
+    deck.write_text(DECK.format(path=(ROOT / "decks" / "tissue" / "carotid_segment.stl").as_posix()))
+    process = subprocess.Popen([sys.executable, "-m", "shellsim", "mesh", str(deck), "--out", str(tmp_path / "out")],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                               env=os.environ | {"COLUMNS": "200"})
+    said, children = "", []
+    while "meshing" not in said and select.select([process.stderr], [], [], 120.0)[0]:
+        said = process.stderr.readline()
+        assert said, "the command ended before it said it was meshing"
+    for _ in range(600):  # the child is forked just after the line
+        children = _children(process.pid)
+        if children:
+            break
+        time.sleep(0.1)
+    assert children, "no meshing child was started"
+    process.kill()
+    process.wait()
+    for _ in range(600):
+        if all(map(_gone, children)):
+            break
+        time.sleep(0.1)
+    survivors = [pid for pid in children if not _gone(pid)]
+    for pid in survivors:
+        os.kill(pid, signal.SIGKILL)
+    assert not survivors, "the meshing child ran on after its parent was killed"

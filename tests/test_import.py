@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 from shellsim.cli import app
 from shellsim.deck import load_deck, parse_deck
 from shellsim.errors import MeshError
-from shellsim.foreign import read_foreign
+from shellsim.foreign import abaqus_model, read_foreign
 from shellsim.foreign.quad_upgrade import split, upgrade
 from shellsim.imported_deck import deck_text, import_model
 from shellsim.geometry import build_mesh
@@ -431,13 +431,23 @@ def test_febio_hgo_and_per_element_material_axes(tmp_path, kind):
     ("bad.feb", "<febio_spec version='4.0'><Mesh/></febio_spec>", r"no shell elements in a <ShellDomain>"),
     ("bad.stl", "solid", r"not a model file shellsim reads \(suffixes: \.feb, \.inp\)"),
     ("bad.inp", "*Nset, nset=A, generate\n1, 100000000000, 1\n", r"bad\.inp:2\): GENERATE from 1 to 100000000000 by 1 "
-                                                                  r"is not a range of at most 10,000,000 labels"),
+                                                                  r"is not a range .* past 10,000,000 labels in all"),
     ("bad.inp", "*Include, input=.\n", r"model file '.*' is not a regular file"),
 ])
 def test_a_broken_model_file_is_refused_naming_its_line(tmp_path, name, text, message):
     path = tmp_path / name
     path.write_text(text)
     with pytest.raises(MeshError, match=message):
+        read_foreign(path)
+
+
+def test_many_generate_lines_are_bounded_in_all_not_each(tmp_path, monkeypatch):
+    """GENERATE lines each within the bound but past it together (30 lines of 10 million
+    labels ran for ever) are refused at the line that passes it."""
+    monkeypatch.setattr(abaqus_model, "MAX_GENERATED", 1000)
+    path = tmp_path / "many.inp"
+    path.write_text("*Heading\n*Nset, nset=A, generate\n" + "1, 400, 1\n" * 30)
+    with pytest.raises(MeshError, match=r"many\.inp:5\): GENERATE from 1 to 400 by 1 .* past 1,000 labels in all"):
         read_foreign(path)
 
 

@@ -694,7 +694,8 @@ def test_a_static_vtu_series_has_its_times_and_renders_and_its_summary_is_strict
 def test_a_run_cut_short_judges_only_the_values_it_reached(tmp_path):
     """The plate stopped at its frame at t = 0.25 (as Ctrl-C stops it) with two references
     it meets there: the tip's value at t = 0.1, reached, is judged; its largest value over
-    the run is not (passed False, with a note), since the run did not see the rest."""
+    the run is not (passed None, with a note), since the run did not see the rest; the
+    plot draws the one judged and not the other at the run's last time as if it were met."""
     from shellsim.execute import run_scene
 
     class StopAtSecondFrame(Listener):
@@ -711,5 +712,14 @@ def test_a_run_cut_short_judges_only_the_values_it_reached(tmp_path):
     assert run.status == "interrupted"
     early, largest = summary["reference"]
     assert early["passed"] and early["computed"] is not None
-    assert not largest["passed"] and largest["computed"] is None
+    assert largest["passed"] is None and largest["computed"] is None
     assert largest["note"].startswith("not judged: the run ended interrupted at t = 0.25, and its max is of the whole run")
+    from matplotlib.figure import Figure
+
+    from shellsim.output.plots import _draw_references
+
+    for whole, drawn in ((True, ["at time", "max"]), (False, ["at time"])):
+        ax = Figure().subplots()
+        times = np.asarray(run.times)
+        _draw_references(ax, run.deck, "tip", times, times, 1.0, 1.0, whole)
+        assert [label.split("(")[1].split(")")[0] for label in ax.get_legend_handles_labels()[1]] == drawn

@@ -13,6 +13,13 @@ from ..loads import DECK_KEYS, measure_names
 from .schema import Deck
 
 
+#: The energies' columns of history.csv, in the order of the time loop's energy indices;
+#: the last, friction's, only where a contact has friction.
+ENERGY_COLUMNS = ("internal_energy", "kinetic_energy", "external_work", "damping_work", "friction_work")
+#: The columns every history.csv has: no probe, contact or measure may take their names.
+OWN_COLUMNS = ("time", "dt", *ENERGY_COLUMNS)
+
+
 def load_factor_columns(deck: Deck) -> dict[str, int]:
     """The history columns of the curves' factors at the load time, each with its curve's
     index in the model's tables: ``load_factor_<curve>`` for every deck curve, and
@@ -93,11 +100,15 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
             need_curve(f"{key}[{i}].curve", getattr(table, "curve", None))
     factors = list(load_factor_columns(deck))
     columns = factors + [p.name for p in deck.output.probe]
+    problems += [f"output.probe[{i}].name: '{probe.name}' is one of history.csv's own columns "
+                 f"({', '.join(OWN_COLUMNS)}); choose another name"
+                 for i, probe in enumerate(deck.output.probe) if probe.name in OWN_COLUMNS]
+    columns += OWN_COLUMNS
     for i, contact in enumerate(deck.contact):
         for column in measure_names([contact.name]):
             if column in columns:
-                problems.append(f"contact[{i}].name: '{column}' is already a history column (a probe's, a curve's "
-                                "load factor or a contact's); choose another name")
+                problems.append(f"contact[{i}].name: '{column}' is already a history column (the history's own, a "
+                                "probe's, a curve's load factor or a contact's); choose another name")
             columns.append(column)
     valve = deck.output.valve
     if valve is not None:

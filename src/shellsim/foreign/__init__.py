@@ -48,6 +48,10 @@ def read_foreign(path: Path) -> ForeignModel:
     except (ValueError, IndexError) as error:  # a number that is not one, a data line cut short
         raise MeshError(f"model file '{path}' holds a value shellsim cannot read ({error}): a number that is not a "
                         "number, or a data line with fields missing") from None
+    except MemoryError:
+        raise MeshError(f"model file '{path}' ({Path(path).stat().st_size / 1e6:,.0f} MB) does not fit in the memory "
+                        "this process may use to read it; read it on a machine with more memory, or split its "
+                        "mesh out") from None
 
 
 def check_model_file(path: Path) -> None:

@@ -328,6 +328,10 @@ class _Builder:
             return None
         c10, d, k1, k2, kappa = ([float(v) for v in k.rows[0]] + [0.0] * 5)[:5]
         axes, families = self._axes(section, prefix)
+        if families is not None and any(np.hypot(*family[:2]) == 0.0 for family in families):
+            self.model.unmapped.append(f"{k.label()}: a LOCAL DIRECTION of the orientation has no length in the "
+                                       "shell's plane, so no fibre angle; the law is left out")
+            return None
         if families is None or len(families) != 2 or not np.isclose(families[0][1], -families[1][1]) \
                 or not np.isclose(families[0][0], families[1][0]):
             self.model.unmapped.append(f"{k.label()}: shellsim's HGO has two fibre families at +-beta from material "
@@ -386,6 +390,10 @@ class _Builder:
         if np.isnan(vectors).any():
             missing = self.shells.labels_of(np.isnan(vectors).any(axis=1))
             raise MeshError(f"{k.label()}: no direction for elements {listed(missing)} (and no default row)")
+        if not np.all(np.linalg.norm(vectors, axis=1) > 0.0):
+            zero = self.shells.labels_of(~(np.linalg.norm(vectors, axis=1) > 0.0))
+            raise MeshError(f"{k.label()}: the direction of elements {listed(zero)} is (0, 0, 0), which points "
+                            "nowhere; give each element a direction")
         field = deck_name(k.param("name") or "orientation", "axis")
         self.shells.cell_vectors[field] = vectors
         return field
@@ -478,7 +486,13 @@ class _Builder:
                     raise MeshError(f"{k.at(line)}: expected 'node or set, first dof[, last dof[, value]]' "
                                     f"or a boundary type ({', '.join(t.upper() for t in BOUNDARY_TYPES)}); got "
                                     f"'{', '.join(row)}'") from None
-                dofs = set(range(first, last + 1))
+                dofs = set(range(max(first, 1), min(last, 6) + 1))
+                if first < 1 or last > 6:
+                    self.model.unmapped.append(f"{k.at(line)}: degrees of freedom {first} to {last} of '{token}': a "
+                                               "shell node has 1-6 (translations 1-3, rotations 4-6); "
+                                               + ("none is" if not dofs else "the others are") + " read")
+                if not dofs:
+                    continue
             if value == 0.0:
                 entry = held.setdefault(token.lower() if qualified("", token) is None else f"node {token.lower()}",
                                         (k, [token], set()))

@@ -13,7 +13,8 @@ import numpy as np
 from ..errors import MeshError
 from .inp_syntax import Keyword, read_keywords
 
-#: The most labels one GENERATE line may give (a typo in a range must not fill the memory).
+#: The most labels the GENERATE lines of a model may give in all (a typo in a range, or
+#: many ranges, must not fill the memory).
 MAX_GENERATED = 10_000_000
 #: Keywords that belong to the *MATERIAL above them.
 MATERIAL_OPTIONS = {"density", "elastic", "hyperelastic", "anisotropic hyperelastic", "user material", "depvar",
@@ -73,6 +74,8 @@ class AbaqusModel:
     steps: list[tuple[Keyword, list[Keyword]]] = field(default_factory=list)
     heading: str = ""
     unmapped: list[str] = field(default_factory=list)
+    generated: int = 0  # labels given by GENERATE lines so far
+    element_at: dict[str, str] = field(default_factory=dict)  # element label -> where it is defined
 
     def node_labels(self, token: str, prefix: str, keyword: Keyword) -> list[str]:
         """The qualified node labels a data field names: a node label ('12', or
@@ -213,8 +216,12 @@ def _geometry(model: AbaqusModel, k: Keyword, prefix: str, move) -> None:
             if not row or not _is_label(row[0]) or not all(_is_label(t) for t in row[1:]):
                 raise MeshError(f"{k.at(line)}: an element is 'label, node, node, ...'; got '{', '.join(row)}'")
             labels.append(qualified(prefix, row[0]))
-            model.elements.append(Element(labels[-1], kind, [qualified(prefix, t) for t in row[1:]],
-                                          f"{k.where.rsplit(':', 1)[0]}:{line}"))
+            where = f"{k.where.rsplit(':', 1)[0]}:{line}"
+            first = model.element_at.setdefault(labels[-1], where)
+            if first != where:
+                raise MeshError(f"{k.at(line)}: element {row[0]} is defined a second time (first at {first}); "
+                                "an element label names one element")
+            model.elements.append(Element(labels[-1], kind, [qualified(prefix, t) for t in row[1:]], where))
         _add(model.elsets, k.param("elset"), named_as, labels)
     elif k.name in ("nset", "elset"):
         _set(model, k, prefix, named_as)
@@ -243,9 +250,10 @@ def _set(model: AbaqusModel, k: Keyword, prefix: str, named_as: str) -> None:
                 first, last, step = (int(v) for v in (row + ["1"])[:3])
             except ValueError:
                 raise MeshError(f"{k.at(line)}: GENERATE takes 'first, last, step'; got '{', '.join(row)}'") from None
-            if step < 1 or (last - first) // step + 1 > MAX_GENERATED:
-                raise MeshError(f"{k.at(line)}: GENERATE from {first} to {last} by {step} is not a range of at most "
-                                f"{MAX_GENERATED:,} labels")
+            model.generated += max(0, (last - first) // max(step, 1) + 1)
+            if step < 1 or model.generated > MAX_GENERATED:
+                raise MeshError(f"{k.at(line)}: GENERATE from {first} to {last} by {step} is not a range of labels, "
+                                f"or takes the model's GENERATE lines past {MAX_GENERATED:,} labels in all")
             labels += [qualified(prefix, str(i)) for i in range(first, last + 1, step)]
     elif is_nodes and k.param("elset"):
         wanted = set(model.element_labels(k.param("elset"), prefix, k))

@@ -3,9 +3,15 @@ from a load kind's deck table besides its own keys."""
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import Annotated, ClassVar
+
+from pydantic import Field
 
 from ..table_types import Name, NonNegative, Positive, Section
+
+#: The largest Coulomb coefficient taken: wet tissue on tissue or a device slides at 0.01-0.5,
+#: dry rubber on rubber at about 1-2; more is a typing mistake, not a surface.
+MOST_FRICTION = 2.0
 
 
 class LoadTable(Section):
@@ -46,7 +52,7 @@ class ContactTable(LoadTable):
     name: Name
     set: Name = "all"
     penalty: Positive = 0.1
-    friction: NonNegative = 0.0
+    friction: Annotated[NonNegative, Field(le=MOST_FRICTION)] = 0.0
     DECK_KEY: ClassVar[str] = "contact"
     SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
     FEATURES: ClassVar[tuple[str, ...]] = ("contact",)

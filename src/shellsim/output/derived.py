@@ -19,8 +19,10 @@ VESSEL_STRESSES = WRITTEN_AS["vessel_stress"]
 def principal_stresses(sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(values (..., 3), directions (..., 3, 3)) of symmetric stresses (..., 3, 3): the
     principal values largest first, and the unit direction of each as a row (its sign
-    arbitrary)."""
-    values, vectors = np.linalg.eigh(sigma)  # ascending, directions as columns
+    arbitrary); NaN where a stress is not a number (the frame of a run that broke down)."""
+    finite = np.isfinite(sigma).all(axis=(-2, -1))
+    values, vectors = np.full(sigma.shape[:-1], np.nan), np.full(sigma.shape, np.nan)
+    values[finite], vectors[finite] = np.linalg.eigh(sigma[finite])  # ascending, directions as columns
     return values[..., ::-1], np.swapaxes(vectors, -1, -2)[..., ::-1, :]
 
 

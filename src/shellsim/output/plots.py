@@ -5,15 +5,16 @@ references drawn on them; and the energies."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 
+from ..deck.references import ENERGY_COLUMNS
 from ..deck.resolved import read_resolved
-from ..errors import OutputError
+from .folder import output_folder, refuse_link, replacing
+from .history import read_history
 from .units import DisplayUnits
-from .folder import output_folder
-from .history import ENERGY_COLUMNS, read_history
 
 PLOTS_DIR = "plots"
 #: How each reference measure is drawn: as points on the curve, or as a level.
@@ -24,6 +25,15 @@ LEVEL_MEASURES = ("max", "min", "max_abs")
 def _read(folder: Path) -> tuple[object, dict[str, np.ndarray]]:
     """(resolved deck, history columns) of a results folder."""
     return read_resolved(folder), read_history(folder)
+
+
+def _completed(folder: Path) -> bool:
+    """Whether the run in ``folder`` reached its end: its summary says 'completed' (a run
+    still going, or one without a summary, has not)."""
+    try:
+        return json.loads((folder / "summary.json").read_text(encoding="utf-8")).get("status") == "completed"
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def _load_axis(deck, times: np.ndarray, units: DisplayUnits) -> tuple[np.ndarray, str] | None:
@@ -54,10 +64,11 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
     from matplotlib.figure import Figure
 
     deck, history = _read(folder)
-    out_dir = output_folder(out_dir or folder / PLOTS_DIR)
+    out_dir = output_folder(out_dir or refuse_link(folder / PLOTS_DIR))
     units = DisplayUnits.of(deck)
     times = history["time"]
     load = _load_axis(deck, times, units)
+    whole = _completed(folder)  # a run cut short is judged, and drawn, only at the times it reached
     written = []
     valve = deck.output.valve.COLUMNS if deck.output.valve is not None else {}
     for name, quantity in [(probe.name, probe.quantity) for probe in deck.output.probe] + list(valve.items()):
@@ -70,7 +81,7 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
         for ax, x, xlabel in zip(axes, (units.scale("time") * t, *((load[0][measured],) if load else ())),
                                  (units.label("time", "time"), *(load[1:] if load else ()))):
             ax.plot(x, values, color="black", lw=1.4, label="shellsim")
-            _draw_references(ax, deck, name, t, x, scale, units.scale("time") if ax is axes[0] else None)
+            _draw_references(ax, deck, name, t, x, scale, units.scale("time") if ax is axes[0] else None, whole)
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
@@ -82,13 +93,18 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
 
 
 def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray, scale: float,
-                     time_scale: float | None) -> None:
+                     time_scale: float | None, whole: bool = True) -> None:
     """The deck's references on ``probe`` over the axis ``x`` (a function of ``times``),
     their values times ``scale`` (into the shown units); ``time_scale`` is the time's when
-    ``x`` is the time axis, None otherwise."""
+    ``x`` is the time axis, None otherwise. Unless the run was ``whole`` (completed), only
+    those at a time it reached: a final value or an extreme of the whole run is not
+    drawn at a run's last time as if it were met."""
     colours = iter(["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"])
-    for measure in dict.fromkeys(r.measure for r in deck.reference if r.probe == probe):
-        refs = [r for r in deck.reference if r.probe == probe and r.measure == measure]
+    measures = [r.measure for r in deck.reference if r.probe == probe
+                and (whole or r.measure == "at_time" and r.time <= times[-1])]
+    for measure in dict.fromkeys(measures):
+        refs = [r for r in deck.reference if r.probe == probe and r.measure == measure
+                and (whole or r.time <= times[-1])]
         colour = next(colours, "grey")
         label = f"reference ({measure.replace('_', ' ')}): {refs[0].source}"
         if measure in POINT_MEASURES:
@@ -140,8 +156,6 @@ def _plot_energy(deck, history: dict[str, np.ndarray], path: Path, size: tuple[f
 
 
 def _save(figure, path: Path) -> Path:
-    try:
-        figure.savefig(path, dpi=110)
-    except OSError as error:
-        raise OutputError(f"cannot write '{path}': {error.strerror or error}") from None
+    with replacing(path) as partial:
+        figure.savefig(partial, dpi=110)
     return path

@@ -22,7 +22,7 @@ def reference_results(run: Run) -> list[dict]:
     """One entry per [reference] of the deck, from the recorded histories: a valve
     measure's from the samples it was taken at. A run that did not complete has only its
     ``at_time`` values judged: a final value, an extreme or a peak over a run cut short
-    is not the run's, so those are not judged (not passed, with a note saying why)."""
+    is not the run's, so those are not judged (``passed`` None, with a note saying why)."""
     times = np.asarray(run.times)
     results = []
     for ref in run.deck.reference:
@@ -30,7 +30,7 @@ def reference_results(run: Run) -> list[dict]:
         taken = ~np.isnan(values) if ref.probe in VALVE_COLUMNS else slice(None)
         entry = check(ref, times[taken], values[taken])
         if run.status != "completed" and ref.measure != "at_time":
-            entry |= {"computed": None, "error": None, "error_percent": None, "passed": False,
+            entry |= {"computed": None, "error": None, "error_percent": None, "passed": None,
                       "note": f"not judged: the run ended {run.status} at t = {run.sim.state.t:.6g}, and its "
                               f"{ref.measure} is of the whole run"}
         results.append(entry)

@@ -279,13 +279,25 @@ def _update_time_step(run: Run, listener: Listener) -> None:
     listener.on_dt(run)
 
 
+#: Mass scaling beyond this factor (a step a thousand times the stable one) is refused:
+#: the run would follow the dynamics of another, far heavier structure.
+MOST_MASS_FACTOR = 1e6
+
+
 def _scale_masses(run: Run, listener: Listener) -> None:
     """Mass scaling: when the first step is shorter than the deck's target, every mass
-    times (target / step)^2 and the step estimated again (a second entry at t = 0)."""
+    times (target / step)^2 and the step estimated again (a second entry at t = 0).
+    Raises SceneTooLarge (the run refused) for a factor beyond MOST_MASS_FACTOR."""
     scaling = run.deck.solver.mass_scaling
     if scaling is None or run.dt >= scaling.step:
         return
-    run.sim.mass_factor = (scaling.step / run.dt) ** 2
+    factor = (scaling.step / run.dt) ** 2
+    if factor > MOST_MASS_FACTOR:
+        raise SceneTooLarge(f"solver.mass_scaling.step = {scaling.step:g} is {scaling.step / run.dt:.3g} times the "
+                            f"stable step {run.dt:.3g}: every mass would be multiplied by {factor:.3g}, more than "
+                            f"{MOST_MASS_FACTOR:g}, and the run would follow another, far heavier structure; ask "
+                            f"for a step of at most {run.dt * MOST_MASS_FACTOR ** 0.5:.3g}")
+    run.sim.mass_factor = factor
     _update_time_step(run, listener)
 
 
@@ -343,7 +355,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
 
     Raises SceneTooLarge (status 'refused') when its steps would take longer than anyone
     waits, before the first sample; NumericalError when the run goes unstable (the samples recorded until then stay
-    in ``run``); KeyboardInterrupt passes through with ``run.status = 'interrupted'``.
+    in ``run``), or relaxing does not come to rest by the end time (status 'not converged');
+    KeyboardInterrupt passes through with ``run.status = 'interrupted'``.
     """
     listener = listener or Listener()
     solver = run.deck.solver
@@ -382,6 +395,14 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
             _frame(run, listener)
             if at_rest:
                 break
+    if run.relaxing is not None and not at_rest:  # the answer asked for is the state of rest
+        run.status = "not converged"
+        residual = run.relaxing.residual
+        raise NumericalError(
+            f"the relaxation did not come to rest by solver.end_time = {solver.end_time:g}: "
+            + (f"its residual force is {residual:.3g} of the force scale, above solver.relaxation.residual = "
+               f"{run.relaxing.tolerance:g}" if residual is not None else "its loads' curves had not yet held")
+            + "; a later end time, or a looser residual, lets it settle")
     return run
 
 

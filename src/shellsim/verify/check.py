@@ -71,6 +71,8 @@ def check(reference: Reference, times: np.ndarray, values: np.ndarray) -> dict:
              "computed": None, "expected": reference.expected, "error": None, "error_percent": None,
              "tolerance_percent": reference.tolerance_percent, "tolerance": reference.tolerance,
              "passed": False, "source": reference.source}
+    if not len(values):
+        return entry | {"note": "the run recorded no samples to measure"}
     try:
         computed = measure(reference, times, values)
     except ValueError as error:

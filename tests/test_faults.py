@@ -151,3 +151,18 @@ def test_runs_that_cannot_give_what_their_deck_asks_say_so(tmp_path):
         result.output.split()), result.output
     summary = json.loads((tmp_path / "restless" / "summary.json").read_text())
     assert summary["status"] == "not converged" and "above solver.relaxation.residual = 1e-09" in summary["message"]
+
+
+def test_a_scene_with_a_cable_writes_contact_pressure_without_a_warning(tmp_path):
+    """The tethered plate (its chord's end a node on no shell, with no area) over a rigid
+    floor, writing contact_pressure with warnings as errors: the cable's node reads 0, not
+    0 / 0 (a RuntimeWarning printed on every run with chordae)."""
+    model = tmp_path / "tethered.feb"
+    model.write_text(tethered_plate_feb("4.0"))
+    deck = import_model(model, tmp_path / "imported").deck
+    deck.write_text(deck.read_text() + '\n[output]\nfields = ["displacement", "contact_pressure"]\n[[contact]]\n'
+                    'type = "rigid_tool"\nname = "floor"\nshape = "plane"\npoint = [0.0, 0.0, -1.0]\n'
+                    'normal = [0.0, 0.0, 1.0]\n')
+    done = subprocess.run([sys.executable, "-W", "error::RuntimeWarning", "-m", "shellsim", "run", str(deck), "--out",
+                           str(tmp_path / "run"), "--quiet"], capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0 and "Warning" not in done.stderr, done.stderr

@@ -189,9 +189,10 @@ def _point_values(sim: Simulation, tensors: tuple[np.ndarray, ...], fields: list
 
 def contact_pressure(sim: Simulation, mesh: OutputMesh) -> np.ndarray:
     """(n,) the contact tools' force on each node over the node's share of the initial
-    mid-surface (``mesh.node_areas``): the pressure the tools put on the shell."""
-    forces = ToolForces(sim.model, []).at_nodes(sim.state.t, sim.state.fields.shape)
-    return np.linalg.norm(forces, axis=1) / mesh.node_areas
+    mid-surface (``mesh.node_areas``): the pressure the tools put on the shell; 0 at a
+    cable's own node, which has no share."""
+    forces = np.linalg.norm(ToolForces(sim.model, []).at_nodes(sim.state.t, sim.state.fields.shape), axis=1)
+    return np.divide(forces, mesh.node_areas, out=np.zeros_like(forces), where=mesh.node_areas > 0.0)
 
 
 def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:

@@ -412,7 +412,8 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
     """Per-element vectors in a quad9 file's cell data (written back by write_mesh_vtu)
     give material axis 1, projected on the lamina and turned by angle_deg: a plate whose
     elements carry (1, 1, 5) (mostly normal to it) gets axis 1 along (1, 1, 0) / sqrt 2,
-    turned 30 degrees toward axis 2 on every layer."""
+    turned 30 degrees toward axis 2 on every layer; the same vectors stored as integers
+    are read as the same directions."""
     import meshio
 
     from shellsim.deck import parse_deck
@@ -423,6 +424,7 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
     write_mesh_vtu(plate, tmp_path / "plate.vtu")
     written = meshio.read(tmp_path / "plate.vtu")
     written.cell_data["fibre"] = [np.tile([1.0, 1.0, 5.0], (plate.n_elements, 1))]
+    written.cell_data["fibre_int"] = [np.tile([1, 1, 5], (plate.n_elements, 1))]  # stored as integers
     written.write(tmp_path / "plate.vtu")
     text = deck_text(f'builder = "file"\npath = "{(tmp_path / "plate.vtu").as_posix()}"')
     text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
@@ -431,11 +433,12 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
     deck = parse_deck(text)
     mesh = build_mesh(deck)
     np.testing.assert_allclose(mesh.cell_vectors["fibre"], np.tile([1.0, 1.0, 5.0], (plate.n_elements, 1)))
+    np.testing.assert_array_equal(mesh.cell_vectors["fibre_int"], mesh.cell_vectors["fibre"])
     axes = build_model(deck, mesh).material.axes0
     expected = np.radians(45.0 + 30.0)
     np.testing.assert_allclose(axes[..., 0, :], np.broadcast_to([np.cos(expected), np.sin(expected), 0.0], axes[..., 0, :].shape),
                                atol=1e-12)
-    with pytest.raises(MeshError, match="material.axes.field = 'fibres'.*it has 'fibre'"):
+    with pytest.raises(MeshError, match="material.axes.field = 'fibres'.*it has 'fibre', 'fibre_int'"):
         build_model(parse_deck(text.replace('field = "fibre"', 'field = "fibres"')), mesh)
 
 
@@ -458,6 +461,32 @@ def test_a_fibre_direction_along_the_shell_normal_is_refused_with_where():
     tilted = parse_deck(text.replace("DIRECTION", f"[{math.sin(math.radians(30))}, 0.0, {math.cos(math.radians(30))}]"))
     axes = build_model(tilted, build_mesh(tilted)).material.axes0
     np.testing.assert_allclose(axes[..., 0, :], np.broadcast_to([1.0, 0.0, 0.0], axes[..., 0, :].shape), atol=1e-12)
+
+
+def test_a_vessel_axis_lying_in_the_shell_is_refused_and_one_across_it_is_not():
+    """Cylindrical axes about x on the plate in z = 0 (the axis lies in the plate): the
+    circumferential direction x cross p is the plate's normal at every point off the axis,
+    and axis 1 was laid by the fallback without a word; refused, naming the elements. About
+    z (across the plate), axis 1 is the circumferential direction, and the point on the
+    axis (the corner at the origin) falls back as a tube's cap does."""
+    from shellsim.deck import parse_deck
+    from shellsim.model import build_model
+
+    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 2, width = 1 }")
+    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+                        'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\n'
+                        'axes = { kind = "cylindrical", axis = AXIS }')
+    lying = parse_deck(text.replace("AXIS", "[1.0, 0.0, 0.0]"))
+    with pytest.raises(MeshError, match=r"the cylindrical material.axes' circumferential direction lies along the "
+                                        r"shell's normal at \d+ of \d+ points, in elements 1, 2 .* the axis lies in "
+                                        "the shell there"):
+        build_model(lying, build_mesh(lying))
+    across = parse_deck(text.replace("AXIS", "[0.0, 0.0, 1.0]"))
+    mesh = build_mesh(across)
+    axes = build_model(across, mesh).material.axes0
+    position = mesh.x[mesh.conn[:, 8]]
+    hoop = np.cross([0.0, 0.0, 1.0], position)
+    np.testing.assert_allclose(axes[:, 4, 0, 0, :], hoop / np.linalg.norm(hoop, axis=1, keepdims=True), atol=1e-12)
 
 
 def test_facets_segmentation_leaves_are_cleaned_and_a_non_manifold_edge_is_named(tmp_path):

@@ -140,7 +140,7 @@ def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
     for k, t in enumerate(tz):
         position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)
         preferred = jac[..., 0] if axes is None else axes.preferred(position, mesh.cell_vectors)
-        if axes is not None and not axes.MAY_MEET_NORMAL:
+        if axes is not None:
             _refuse_along_normal(axes, jac, preferred, mesh.x[mesh.conn[:, 8]])
         frames = lamina_axes(jac, preferred)
         a1 = np.cos(turns[k]) * frames[..., 0, :] + np.sin(turns[k]) * frames[..., 1, :]
@@ -155,22 +155,30 @@ ALONG_NORMAL = 1e-2
 
 
 def _refuse_along_normal(axes, jac: np.ndarray, preferred: np.ndarray, centres: np.ndarray) -> None:
-    """Raise MeshError where ``preferred`` (ne, q, 3), a direction the deck or the mesh
-    gives, lies along the lamina normal of ``jac`` (ne, q, 3, 3): naming the key, the
-    count of points and elements and the first element's place (``centres`` (ne, 3))."""
+    """Raise MeshError where ``preferred`` (ne, q, 3), the direction the axes give, lies
+    along the lamina normal of ``jac`` (ne, q, 3, 3): naming the key, the count of points
+    and elements and the first element's place (``centres`` (ne, 3)). A rule about an
+    axis (``MAY_MEET_NORMAL``) gives no direction on the axis itself (a tube's cap), where
+    axis 1 falls back to the element's own; elsewhere its direction along the normal
+    means the axis lies in the shell, and the fibres would be laid by round-off."""
     normal = np.cross(jac[..., 0], jac[..., 1])
     normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
-    across = np.linalg.norm(np.cross(preferred, normal), axis=-1) / np.linalg.norm(preferred, axis=-1)
-    along = across < ALONG_NORMAL
+    size = np.linalg.norm(preferred, axis=-1)
+    along = np.linalg.norm(np.cross(preferred, normal), axis=-1) < ALONG_NORMAL * size
+    if axes.MAY_MEET_NORMAL:
+        along &= size > 1e-6 * size.max(initial=0.0)  # on the axis: no direction, the fallback's place
     if not along.any():
         return
     elements = np.flatnonzero(along.any(axis=1))
-    key = (f"material.axes.direction = {place(axes.direction)}" if axes.kind == "fixed"
-           else f"material.axes.field = '{axes.field}'")
+    key = {"fixed": f"material.axes.direction = {place(getattr(axes, 'direction', ()))}",
+           "mesh": f"material.axes.field = '{getattr(axes, 'field', '')}'"}.get(
+        axes.kind, f"the {axes.kind} material.axes' circumferential direction")
+    advice = ("the axis lies in the shell there: give the vessel's own axis, or fixed or mesh axes"
+              if axes.MAY_MEET_NORMAL else "give a direction in the shell's plane")
     raise MeshError(f"{key} lies along the shell's normal at {int(along.sum())} of {along.size} points, in "
                     f"elements {id_list(elements + 1)} (element {elements[0] + 1} at "
                     f"{place(centres[elements[0]])}): material axis 1 is its projection on the shell, "
-                    "which is not defined there; give a direction in the shell's plane")
+                    f"which is not defined there; {advice}")
 
 
 def lamina_axes(jac: np.ndarray, preferred: np.ndarray) -> np.ndarray:

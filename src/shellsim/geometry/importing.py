@@ -141,13 +141,14 @@ def _finite(path: Path, where: str, name: str, values: np.ndarray, ids: np.ndarr
 
 
 def _cell_arrays(path: Path, m, blocks: list[int]) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """The float cell data on every quad9 block: vectors of three components (ne, 3) by
+    """The numeric cell data on every quad9 block (integers too: a file may store unit
+    fibre directions as integers), as floats: vectors of three components (ne, 3) by
     name, non-finite or zero ones refused naming the elements, and scalar fields (ne,),
     non-finite ones refused; gmsh's tags and the set markers are left to the sets."""
     vectors, scalars = {}, {}
     for name, per_block in m.cell_data.items():
         arrays = [np.asarray(per_block[i]) for i in blocks]
-        if name.startswith((SET_PREFIX, "gmsh:")) or not all(a.dtype.kind == "f" for a in arrays):
+        if name.startswith((SET_PREFIX, "gmsh:")) or not all(a.dtype.kind in "fiu" for a in arrays):
             continue
         if all(a.ndim == 1 or (a.ndim == 2 and a.shape[1] == 1) for a in arrays):
             values = np.concatenate([a.reshape(-1) for a in arrays]).astype(float)

@@ -26,9 +26,10 @@ class TurnedAxes(Section):
     lamina; ``cell_vectors`` are the mesh's per-element vectors by name."""
 
     angle_deg: Union[Angle, Annotated[list[Angle], Field(min_length=2)]] = 0.0
-    #: Whether the preferred direction may lie along the lamina normal, axis 1 then
-    #: falling back to the element's own first direction: a rule about an axis meets it on
-    #: the axis (a tube's cap); a direction the deck or the mesh gives never should.
+    #: Whether the preferred direction may vanish, axis 1 then falling back to the
+    #: element's own first direction: a rule about an axis gives none on the axis (a tube's
+    #: cap); a direction the deck or the mesh gives always has one. Along the lamina
+    #: normal it is refused either way (:func:`shellsim.model.material_frames`).
     MAY_MEET_NORMAL: ClassVar[bool] = True
 
     def angles(self, depths: np.ndarray) -> np.ndarray:

@@ -185,3 +185,45 @@ def test_load_control_jumping_over_the_roof_s_snap_says_so():
     assert jumps[0]["load_time_from"] <= 0.7421 * 1.02 and jumps[0]["load_time_to"] >= 0.7421
     far = np.interp(1.0, [0.9643, 1.0835], [28.663, 29.374])  # Sze's last two points, past the table above
     assert -run.history["crown_deflection"][-1] == pytest.approx(far, rel=0.005)
+
+
+def test_load_steps_grow_back_after_a_cut_even_where_every_step_forms_many_tangents():
+    """Load control whose Newton solver cuts the second step to a quarter, and then forms
+    8 tangents at every step whatever its length (a thin plate's linear convergence did
+    so, and its steps stayed at 1/256 of the first for the rest of the run): the length
+    grows by half after every second uncut step, back to the first step's, and the run
+    ends at its end time."""
+    from shellsim.execute import built_run
+    from shellsim.solver import static
+    from shellsim.solver.run import Listener
+
+    run = built_run(_deck("test02_cantilever_uniform_load_3_static", {"increments = 4": "increments = 10"}),
+                    ROOT / "decks" / "verification")
+    tried: list[float] = []
+
+    class Cutting:
+        """The solver's stepping, as a plate that needs 8 tangents a step lets it go."""
+        settings = run.deck.solver.static
+
+        def observe(self):
+            pass
+
+        def reach(self, landing, length):
+            cut = len(tried) == 1
+            length = length * static.CUT if cut else length
+            target = min(landing, run.sim.state.t + length)
+            tried.append(target - run.sim.state.t)
+            return static.NewtonStep(t=target, load_time=target, iterations=16, tangents=8, residual=1e-7,
+                                     cutbacks=int(cut)), length
+
+        def commit(self, step):
+            run.newton.append(step)
+
+    static._load_steps(run, Cutting(), Listener(), run.deck.solver.end_time)
+    first = run.deck.solver.end_time / 10
+    assert run.sim.state.t == pytest.approx(run.deck.solver.end_time)
+    assert tried[1] == pytest.approx(first * static.CUT)
+    grown = [b / a for a, b in zip(tried[1:], tried[2:]) if b / a > 1.0 + 1e-9]
+    assert grown and all(ratio == pytest.approx(static.GROW) or ratio < static.GROW for ratio in grown)
+    assert max(tried[2:]) == pytest.approx(first)
+    assert len(tried) < 20

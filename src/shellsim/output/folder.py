@@ -74,6 +74,7 @@ def replacing(path: Path) -> Iterator[Path]:
     """A new file of its own beside ``path`` (its suffix kept, for writers that go by
     it) for the body to write, renamed over ``path`` when the body ends, removed when it
     raises. OutputError when it cannot be made or renamed."""
+    path = Path(path)
     try:
         handle, partial = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".partial{path.suffix}", dir=path.parent)
         os.close(handle)

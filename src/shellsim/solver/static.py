@@ -11,7 +11,11 @@ energies (:mod:`.static_work`).
 Step control: a step that does not converge in ``max_iterations`` (or whose residual
 turns to no number, or whose tangent is singular) is taken again from the last converged
 state at a quarter of its length; one that converges with at most GROWTH_TANGENTS
-tangents formed lets the next grow by half, up to the deck's first length. The outputs
+tangents formed, or the second of two in a row that converged without a cut, lets the
+next grow by half, up to the deck's first length. The second rule is what lets a step
+grow back where every step needs many tangents whatever its length (a thin plate whose
+finite-difference tangent converges linearly: steps cut to 1/256 of the first stayed
+there for the rest of the run). The outputs
 are the explicit run's: a history sample at every converged step, frames at the output
 times.
 """
@@ -356,6 +360,7 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
     landings = output_times(run.deck)
     newton.observe()  # the first step's tangent, at the start
     observed = sim.state.t  # the load time of the last stability check
+    uncut = 0  # steps in a row that converged at the length they were tried at
     for landing in np.append(landings[landings < end], end):
         while sim.state.t < landing - 1e-12 * end:
             step, length = newton.reach(landing, length)
@@ -365,8 +370,9 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
                 newton.observe()  # the end's is the run's last
                 observed = step.t
             _record(run, listener)
-            if step.tangents <= GROWTH_TANGENTS and step.cutbacks == 0:
-                length = min(length * GROW, largest)
+            uncut = uncut + 1 if step.cutbacks == 0 else 0
+            if step.cutbacks == 0 and (step.tangents <= GROWTH_TANGENTS or uncut >= 2):
+                length, uncut = min(length * GROW, largest), 0
         _frame(run, listener)
 
 

@@ -4,7 +4,7 @@ and each job of a study call."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from contextlib import ExitStack, closing
+from contextlib import ExitStack, closing, suppress
 from pathlib import Path
 
 from . import __version__
@@ -130,9 +130,16 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
             kept_samples, kept_frames = len(current.times), len(current.frame_times)
         message = None
         with ExitStack() as files:
-            history = files.enter_context(closing(HistoryWriter(folder / "history.csv", kept_samples)))
-            frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
-            check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
+            try:
+                history = files.enter_context(closing(HistoryWriter(folder / "history.csv", kept_samples)))
+                frames = files.enter_context(closing(FrameWriter(folder, current, scene.output, kept_frames)))
+                check_space(folder, frames.frame_bytes() * (len(output_times(scene)) + 1))
+            except OutputError as error:  # a full disk: the summary says so, if there is room for it
+                files.close()
+                current.status = "output failed"
+                with suppress(OutputError):
+                    write_json(unstarted(scene, deck_path, str(error), current.status), folder / "summary.json")
+                raise
             interval = scene.output.checkpoint_interval
             checkpoints = [Checkpoints(folder, interval, current.sim.state.t)] if interval else []
             writers = Timed(Listeners(history, frames, *checkpoints))
@@ -145,7 +152,10 @@ def run_scene(scene: Deck, deck_path: Path, folder: Path, progress: Listener | N
             except OutputError as error:
                 current.status, message = "output failed", str(error)
             finally:
-                files.close()
+                try:
+                    files.close()
+                except OutputError as error:  # what the files still held did not fit
+                    current.status, message = "output failed", str(error)
                 if frames.written > len(current.frame_times):  # in every series, though a checkpoint after it failed
                     current.frame_times.append(current.sim.state.t)
                 result = summary(current, deck_path, plan(scene), message, writers.seconds)

@@ -41,15 +41,22 @@ class HistoryWriter(Listener):
 
     def on_sample(self, run: Run) -> None:
         if not self._header_written:
-            self._writer.writerow(["time", "dt", *energy_columns(run), *run.history])
+            self._writer.writerow(["time", "dt", *energy_columns(run), *run.history])  # flushed with the first row
             self._header_written = True
         energy = run.energies[-1][:len(energy_columns(run))]
         row = [run.times[-1], run.dt, *energy, *(values[-1] for values in run.history.values())]
-        self._writer.writerow([f"{v:.12g}" for v in row])
-        self._file.flush()
+        try:
+            self._writer.writerow([f"{v:.12g}" for v in row])
+            self._file.flush()
+        except OSError as error:
+            raise OutputError(f"cannot write '{self.path}': {error.strerror or error}") from None
 
     def close(self) -> None:
-        self._file.close()
+        """Close the file; OutputError when what it still held cannot be written (a full disk)."""
+        try:
+            self._file.close()
+        except OSError as error:
+            raise OutputError(f"cannot write '{self.path}': {error.strerror or error}") from None
 
 
 def read_history(folder: Path) -> dict[str, np.ndarray]:

@@ -26,6 +26,9 @@ CABLES = "cables"
 
 
 SERIES = {"xdmf": XdmfSeries, "vtu": VtuSeries}
+#: Room kept free beyond twice a frame's data before each frame is written [bytes]: the
+#: series' metadata, the XML rewritten beside the old, a checkpoint, the summary.
+FRAME_MARGIN = 2**18
 
 
 class FrameWriter(Listener):
@@ -33,6 +36,7 @@ class FrameWriter(Listener):
     on from a checkpoint, after the first ``kept`` frames of each series in ``folder``."""
 
     def __init__(self, folder: Path, run: Run, output: Output, kept: int | None = None):
+        self.folder = folder
         self.fields, self.vessel_axes, self.faces = list(output.fields), output.vessel_axes, tuple(output.faces)
         self.part = output_mesh(run.model, output.solid)
         self.copies = mirrors(mirror_planes(run.deck, run.mesh))
@@ -62,36 +66,59 @@ class FrameWriter(Listener):
     def frame_bytes(self) -> int:
         """Bytes one frame of the current state takes in every format, uncompressed (data
         only)."""
-        point_data, cell_data = self._fields(self.run)
+        return self._bytes(*self._fields(self.run))
+
+    def _bytes(self, point_data: dict, cell_data: dict) -> int:
+        """Bytes a frame of these fields takes in every format, uncompressed (data only)."""
         values = sum(a.size for a in (*point_data.values(), *cell_data.values()))
         return len(self.series) * values * np.dtype(self.encoding.float_type).itemsize
 
     def on_frame(self, run: Run) -> None:
         point_data, cell_data = self._fields(run)
+        # HDF5 meeting a full disk mid-write leaves its file in a state that later crashes
+        # the process: the room is made sure of first
         t = float(run.sim.state.t)  # a numpy scalar would be written as its repr
+        check_space(self.folder, 2 * self._bytes(point_data, cell_data) + FRAME_MARGIN, f"the frame at t = {t:.6g}")
         written = [(series, point_data, cell_data) for series in self.series]
         if self.cable_series:
             written += [(series, *cable_fields(run.sim, self.cables)) for series in self.cable_series]
         for series, point_values, cell_values in written:
             try:
                 series.write(t, point_values, cell_values)
-            except OSError as error:
+            except (OSError, RuntimeError) as error:  # HDF5 reports a full disk as a RuntimeError
                 raise OutputError(f"writing the frame at t = {t:.6g} to {series.path} failed: "
-                                  f"{error.strerror or error}") from None
+                                  f"{getattr(error, 'strerror', None) or error}") from None
         self.written += 1
 
     def close(self) -> None:
+        """Close every series, each even when one before it fails; OutputError naming the
+        first that could not write what it still held (a full disk)."""
+        failed = None
         for series in self.series + self.cable_series:
-            series.close()
+            try:
+                series.close()
+            except (OSError, RuntimeError) as error:
+                failed = failed or f"cannot write '{series.path}': {getattr(error, 'strerror', None) or error}"
+        if failed:
+            raise OutputError(failed)
 
 
-def check_space(folder: Path, needed: int) -> None:
-    """Raise OutputError when ``folder``'s disk has less than ``needed`` bytes free."""
+def check_space(folder: Path, needed: int, what: str = "the run's frames") -> None:
+    """Raise OutputError when ``folder``'s disk has less than the ``needed`` bytes that
+    ``what`` needs free."""
     free = shutil.disk_usage(folder).free
     if needed > free:
-        raise OutputError(f"the run's frames need about {needed / 1e6:,.0f} MB but '{folder}' has "
-                          f"{free / 1e6:,.0f} MB free; write fewer frames (output.interval) or fields "
-                          "(output.fields), or choose another --out")
+        raise OutputError(f"{what} need{'s' if what.startswith('the frame ') else ''} about {_size(needed)} but "
+                          f"'{folder}' has {_size(free)} free (the disk is full or nearly): write fewer frames "
+                          "(output.interval) or fields (output.fields), or choose another --out")
+
+
+def _size(n_bytes: float) -> str:
+    """'420 MB', '35 kB', '512 bytes'."""
+    for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n_bytes >= size:
+            return f"{n_bytes / size:,.3g} {unit}"
+    return f"{n_bytes:,.0f} bytes"
 
 
 class StoredSeries:

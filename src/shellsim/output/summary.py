@@ -88,10 +88,11 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
     }
 
 
-def unstarted(scene, deck_path: Path, message: str) -> dict:
+def unstarted(scene, deck_path: Path, message: str, status: str = "not converged") -> dict:
     """The record of a run that failed before its first step (an imaged scene whose
-    unloaded shape was not found): what was run, its status and why."""
-    return {"deck": str(deck_path), "title": scene.meta.title, "version": __version__, "status": "not converged",
+    unloaded shape was not found; 'output failed', a disk too full for its first files):
+    what was run, its status and why."""
+    return {"deck": str(deck_path), "title": scene.meta.title, "version": __version__, "status": status,
             "method": scene.solver.method, "message": message, "steps": 0, "reference": []}
 
 

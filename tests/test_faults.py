@@ -21,6 +21,7 @@ from shellsim.output.derived import principal_stresses
 
 from .conftest import ROOT, pressed_plates_deck, problems_of
 from .test_import import feb_held, strip_inp, tethered_plate_feb
+from .test_run_folder import PLATE
 
 runner = CliRunner()
 
@@ -175,3 +176,20 @@ def test_contact_pressure_at_a_cable_s_own_node_is_zero_without_a_warning(monkey
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         np.testing.assert_array_equal(fields.contact_pressure(sim, mesh), [2.0, 2.0, 0.0])
+
+
+def test_render_while_a_run_writes_its_series_is_a_message(tmp_path):
+    """A run's results.h5 held open for writing (as a running run holds it; HDF5 locks the
+    file) while ``shellsim render`` reads the folder: exit code 2 and a message saying a
+    run may still be writing it, not h5py's traceback."""
+    import h5py
+
+    deck = tmp_path / "plate.toml"
+    deck.write_text(PLATE)
+    folder = tmp_path / "run"
+    assert runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"]).exit_code == 0
+    with h5py.File(folder / "results.h5", "a"):
+        done = subprocess.run([sys.executable, "-m", "shellsim", "render", str(folder)], capture_output=True, text=True,
+                              timeout=300, env=os.environ | {"COLUMNS": "300"})
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "a run may still be writing it" in done.stderr

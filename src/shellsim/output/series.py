@@ -133,7 +133,11 @@ class StoredSeries:
         xdmf, pvd = folder / f"{name}.xdmf", folder / f"{name}.pvd"
         if xdmf.exists():
             self._reader = meshio.xdmf.TimeSeriesReader(xdmf)
-            points, cells = self._reader.read_points_cells()
+            try:
+                points, cells = self._reader.read_points_cells()
+            except OSError as error:  # HDF5 locks a file while a run writes it
+                raise OutputError(f"cannot read the series in '{folder}' ({error.strerror or error}): a run may "
+                                  "still be writing it; read it once the run has ended") from None
             # the times from the XML alone: reading each frame's data here would read it twice
             self.times = [float(t.get("Value")) for t in ET.parse(xdmf).getroot().iter("Time")]
         elif pvd.exists():

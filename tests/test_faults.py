@@ -193,3 +193,22 @@ def test_render_while_a_run_writes_its_series_is_a_message(tmp_path):
                               timeout=300, env=os.environ | {"COLUMNS": "300"})
     assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
     assert "a run may still be writing it" in done.stderr
+
+
+def test_divisions_too_many_for_the_memory_are_refused_before_meshing(tmp_path, monkeypatch):
+    """The aortic valve builder at 2000 x 2000 x 200 divisions (gmsh died of a
+    segmentation fault meshing it) on a machine with 24 GB free: refused at once by
+    ``check``, exit code 2, naming the elements the divisions give (3 x 2000 x 2200) and
+    the memory they need."""
+    from shellsim import memory
+
+    monkeypatch.setattr(memory, "available_bytes", lambda: 24e9)
+    deck = tmp_path / "valve.toml"
+    text = (ROOT / "decks" / "valves" / "aortic_valve_closing.toml").read_text()
+    assert "divisions = { around = 12, belly = 6, coaptation = 2 }" in text
+    deck.write_text(text.replace("divisions = { around = 12, belly = 6, coaptation = 2 }",
+                                 "divisions = { around = 2000, belly = 2000, coaptation = 200 }"))
+    result = runner.invoke(app, ["check", str(deck)])
+    message = " ".join(result.output.split())
+    assert result.exit_code == 2 and "[mesh] divisions give 13,200,000 elements: a run needs about 264 GB of memory and 24 GB is " \
+        "available" in message

@@ -14,7 +14,7 @@ PACKAGE = Path(shellsim.__file__).parent
 #: The floors, lowest first; a module belongs to the floor of its top-level part.
 FLOORS = [
     {"__init__", "errors", "table_types", "lanes", "array_copy", "bundles", "compiled_call", "compile_watch",
-     "cache_lock", "compile_beside", "curve_tables", "signals", "threads", "mesh_reading", "printable"},
+     "cache_lock", "compile_beside", "curve_tables", "signals", "threads", "mesh_reading", "printable", "memory"},
     {"tensor3"},
     {"materials"},
     {"element"},

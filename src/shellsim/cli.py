@@ -520,7 +520,8 @@ THIN_SHELL_GAIN = 2.0
 
 
 def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
-    from .solver.outlook import duration, size_text
+    from .memory import size_text
+    from .solver.outlook import duration
 
     table = Table(title=shown(scene.meta.title), show_header=False, title_justify="left")
     table.add_column(style="bold")

@@ -23,7 +23,7 @@ def sized_mesh(scene: Deck, deck_folder: Path, announce: Callable[[str], None] =
     and the memory a run of it holds told to ``announce``. Raises SceneTooLarge for a mesh
     that would not fit in memory."""
     from .geometry import build_mesh
-    from .solver.outlook import memory_bytes, refuse_if_too_big, size_text
+    from .memory import memory_bytes, refuse_if_too_big, size_text
 
     announce("meshing")
     mesh = build_mesh(scene, deck_folder)

@@ -24,6 +24,7 @@ from ..deck.geometry import (
     AnnularSector, AorticValve, CylindricalPanel, Hemisphere, PlateWithHole, Rectangle, Tube, TwistedStrip,
 )
 from ..deck.schema import MeshOptions
+from ..memory import refuse_if_too_big
 
 Hint = Callable[[np.ndarray], np.ndarray]
 
@@ -42,6 +43,7 @@ class Sketch:
         self.geo = gmsh.model.geo
         self._curves: dict[frozenset, tuple[int, int, int]] = {}
         self._groups: dict[tuple[int, str], list[int]] = {}
+        self.elements = 0  # the patches' elements, known before gmsh meshes them
 
     def point(self, xyz: tuple[float, float, float] | np.ndarray) -> int:
         return self.geo.addPoint(*map(float, xyz))
@@ -65,6 +67,8 @@ class Sketch:
 
     def patch(self, curves: list[int], flat: bool = False, sphere_centre: int = -1) -> int:
         """A structured four-sided patch bounded by ``curves`` (signed, in loop order)."""
+        divisions = {abs(tag): n for tag, _, n in self._curves.values()}
+        self.elements += divisions[abs(curves[0])] * divisions[abs(curves[1])]
         loop = self.geo.addCurveLoop(curves)
         if flat:
             surface = self.geo.addPlaneSurface([loop])
@@ -79,7 +83,10 @@ class Sketch:
         self._groups.setdefault((dim, name), []).extend(abs(t) for t in tags)
 
     def finish(self) -> None:
-        """Synchronise, mesh as complete 9-node quads, create the physical groups."""
+        """Synchronise, mesh as complete 9-node quads, create the physical groups. Raises
+        SceneTooLarge first when a run of the patches' elements would not fit in memory
+        (gmsh meshing 8e8 elements died of a segmentation fault)."""
+        refuse_if_too_big(self.elements, "[mesh] divisions give")
         self.geo.synchronize()
         for (dim, name), tags in self._groups.items():
             self.gmsh.model.addPhysicalGroup(dim, sorted(set(tags)), name=name)

@@ -3,9 +3,8 @@ and the wall time they take; a scene that cannot fit in memory or finish in a ye
 refused with the numbers that say why.
 
 The rates are measured on this project's reference machine (docs/verification.md,
-"Cost of a scene"): a run holds about 20 kB per element after a base of 0.4 GB (a
-90,000-element plate peaked at 1.9 GB), and one step of a group of 16 elements takes
-about 130 us on one thread.
+"Cost of a scene"): one step of a group of 16 elements takes about 130 us on one thread;
+the memory a run holds is :mod:`shellsim.memory`'s.
 """
 
 from __future__ import annotations
@@ -21,39 +20,14 @@ from ..deck.schema import Solver
 from ..element.groups import group_count
 from ..element.tangent import FORWARD_BATCHES
 from ..errors import SceneTooLarge
+from ..memory import memory_bytes
 from ..model import Model
 from ..loads import stable_step
 from .simulation import Simulation
 
-BASE_BYTES, BYTES_PER_ELEMENT = 0.4e9, 20e3
 SECONDS_PER_GROUP_STEP = 130e-6
 #: A run longer than this is not one anybody will wait for: it is refused.
 HOPELESS_SECONDS = 365 * 24 * 3600.0
-
-
-def memory_bytes(n_elements: int) -> float:
-    """About how much memory a run of ``n_elements`` holds at its peak [bytes]."""
-    return BASE_BYTES + BYTES_PER_ELEMENT * n_elements
-
-
-def available_bytes() -> float | None:
-    """Memory available to a new process now [bytes] (Linux), or None where it cannot be read."""
-    try:
-        with open("/proc/meminfo") as info:
-            for line in info:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
-
-
-def refuse_if_too_big(n_elements: int) -> None:
-    """Raise SceneTooLarge when the run would not fit in the memory available."""
-    need, have = memory_bytes(n_elements), available_bytes()
-    if have is not None and need > have:
-        raise SceneTooLarge(f"the mesh has {n_elements:,} elements: a run needs about {size_text(need)} of memory "
-                            f"and {size_text(have)} is available; coarsen [mesh] divisions or use a larger machine")
 
 
 def seconds_per_step(n_elements: int) -> float:
@@ -122,6 +96,3 @@ def duration(seconds: float) -> str:
     return f"{seconds / (365 * 86400):.3g} years"
 
 
-def size_text(n_bytes: float) -> str:
-    """'1.9 GB', '420 MB'."""
-    return f"{n_bytes / 1e9:.2g} GB" if n_bytes >= 1e9 else f"{n_bytes / 1e6:.3g} MB"

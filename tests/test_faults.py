@@ -212,3 +212,21 @@ def test_divisions_too_many_for_the_memory_are_refused_before_meshing(tmp_path, 
     message = " ".join(result.output.split())
     assert result.exit_code == 2 and "[mesh] divisions give 13,200,000 elements: a run needs about 264 GB of memory and 24 GB is " \
         "available" in message
+
+
+def test_a_static_summary_states_the_load_reached_and_the_largest_on_the_way():
+    """A path that went up to load time 0.3 and back to 0.2 (past a limit point, where an
+    arc-length run's clock can end short of its load): the summary's static record says
+    both, and each curve's largest load factor."""
+    from types import SimpleNamespace
+
+    from shellsim.output.summary import static_record
+    from shellsim.solver.static import NewtonStep
+
+    steps = [NewtonStep(t=t, load_time=load, iterations=3, tangents=1, residual=1e-8, cutbacks=0)
+             for t, load in ((0.1, 0.1), (0.3, 0.3), (0.4, 0.2))]
+    run = SimpleNamespace(newton=steps, stability=None, load_factors={"load_factor_ramp": 0},
+                          history={"load_factor_ramp": [0.0, 0.1, 0.3, 0.2]})
+    record = static_record(run)
+    assert (record["load_time_reached"], record["largest_load_time"]) == (0.2, 0.3)
+    assert record["largest_load_factors"] == {"load_factor_ramp": 0.3}

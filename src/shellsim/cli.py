@@ -291,7 +291,8 @@ def _run_report(result: dict, folder: Path) -> Table | str:
     static = result.get("static")
     caption = ((f"{static['load_steps']} load steps, {static['iterations']} Newton iterations "
                 f"({static['tangents']} tangents), "
-                f"{static['cutbacks']} cut back, {result['wall_time_s']:.2f} s") if static else
+                f"{static['cutbacks']} cut back, load time reached {static['load_time_reached']:.6g} (largest "
+                f"{static['largest_load_time']:.6g}), {result['wall_time_s']:.2f} s") if static else
                (f"{result['steps']} steps, {result['wall_time_s']:.2f} s, "
                 f"{result['us_per_element_step']:.2f} us/element-step, energy balance "
                 f"{e['balance_error_percent']:+.3f}%")

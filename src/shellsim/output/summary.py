@@ -98,10 +98,15 @@ def unstarted(scene, deck_path: Path, message: str, status: str = "not converged
 
 def static_record(run: Run) -> dict:
     """A static solve's load steps: how many, the Newton iterations, tangents formed and
-    cut-backs over them, the largest relative residual a step ended with, each step, and
-    where the path lost or regained stability (:meth:`.stability.StabilityWatch.events`)."""
+    cut-backs over them, the largest relative residual a step ended with, the load time
+    reached at the end and the largest on the way (an arc-length path's clock can end
+    short of its load) with each curve's largest load factor, each step, and where the
+    path lost or regained stability (:meth:`.stability.StabilityWatch.events`)."""
     steps = [vars(step) for step in run.newton]
     return {"load_steps": len(steps), "iterations": sum(s["iterations"] for s in steps),
+            "load_time_reached": steps[-1]["load_time"] if steps else 0.0,
+            "largest_load_time": max((s["load_time"] for s in steps), default=0.0),
+            "largest_load_factors": {column: max(run.history[column], default=0.0) for column in run.load_factors},
             "tangents": sum(s["tangents"] for s in steps),
             "cutbacks": sum(s["cutbacks"] for s in steps),
             "largest_residual": max((s["residual"] for s in steps), default=0.0),

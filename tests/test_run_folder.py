@@ -64,9 +64,9 @@ def test_a_second_run_into_a_folder_in_use_is_refused_and_touches_nothing(tmp_pa
 
 
 def test_a_new_run_clears_what_an_earlier_run_left(tmp_path):
-    """An earlier run's summary, checkpoint, VTU frames and cable series are gone once a
-    new run (writing XDMF only, no cables, no checkpoints) has started; the summary there is
-    the new run's."""
+    """An earlier run's summary, checkpoint, VTU frames, cable series and plots are gone
+    once a new run (writing XDMF only, no cables, no checkpoints) has started; the summary
+    there is the new run's."""
     deck = tmp_path / "plate.toml"
     deck.write_text(PLATE)
     folder = tmp_path / "run"
@@ -76,10 +76,12 @@ def test_a_new_run_clears_what_an_earlier_run_left(tmp_path):
         (folder / name).write_text("earlier")
     (folder / "summary.json").write_text(json.dumps({"status": "completed", "title": "an earlier scene"}))
     (folder / "notes.txt").write_text("the user's own")
+    (folder / "plots").mkdir()
+    (folder / "plots" / "tip.png").write_bytes(b"an earlier run's plot")
     result = runner.invoke(app, ["run", str(deck), "--out", str(folder), "--quiet"])
     assert result.exit_code == 0, result.output
     left = {path.name for path in folder.iterdir()}
-    assert not left & {"frames", "results.pvd", "cables.xdmf", "cables.h5", "checkpoint.npz"}
+    assert not left & {"frames", "results.pvd", "cables.xdmf", "cables.h5", "checkpoint.npz", "plots"}
     assert json.loads((folder / "summary.json").read_text())["title"] == "test scene"
     assert (folder / "notes.txt").read_text() == "the user's own"
 

@@ -73,16 +73,17 @@ def solve(run: Run, listener: Listener | None = None) -> Run:
 
 
 def _run_files() -> tuple[str, ...]:
-    """The files and folders a run writes into its folder, renders included."""
+    """The files and folders a run writes into its folder, renders and plots included."""
     from .deck.resolved import RESOLVED_NAME
     from .output.checkpoint import CHECKPOINT_NAME, PICKLED_NAME
+    from .output.plots import PLOTS_DIR
     from .output.render import RENDERS_DIR
     from .output.series import CABLES
     from .output.vtu import FRAMES_DIR
 
     series = tuple(f"{name}.{kind}" for name in ("results", CABLES) for kind in ("xdmf", "h5", "pvd"))
-    return (RESOLVED_NAME, "history.csv", "summary.json", CHECKPOINT_NAME, PICKLED_NAME, RENDERS_DIR, FRAMES_DIR,
-            f"{CABLES}_{FRAMES_DIR}", *series)
+    return (RESOLVED_NAME, "history.csv", "summary.json", CHECKPOINT_NAME, PICKLED_NAME, RENDERS_DIR, PLOTS_DIR,
+            FRAMES_DIR, f"{CABLES}_{FRAMES_DIR}", *series)
 
 
 def _start_afresh(folder: Path, scene: Deck, deck_path: Path) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import warnings
@@ -230,3 +231,25 @@ def test_a_static_summary_states_the_load_reached_and_the_largest_on_the_way():
     record = static_record(run)
     assert (record["load_time_reached"], record["largest_load_time"]) == (0.2, 0.3)
     assert record["largest_load_factors"] == {"load_factor_ramp": 0.3}
+
+
+def test_a_stop_while_the_meshing_child_is_forked_is_not_lost():
+    """Ctrl-C arriving inside the fork's own hooks (as one did in the logging module's,
+    where it was printed as ignored and lost, and the meshing ran on): the child is
+    killed and the interrupt raised once the fork is done, not half a minute later."""
+    import time
+
+    from shellsim.geometry.child import in_child
+
+    armed: list[bool] = []
+
+    def interrupt_in_the_hook() -> None:
+        if armed:
+            armed.clear()
+            os.kill(os.getpid(), signal.SIGINT)
+            sum(range(10_000))  # Python code in the hook, where the interrupt would be raised
+
+    os.register_at_fork(after_in_parent=interrupt_in_the_hook)
+    armed.append(True)
+    with pytest.raises(KeyboardInterrupt):
+        in_child(time.sleep, 30.0)

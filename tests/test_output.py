@@ -335,7 +335,8 @@ def test_a_solid_series_is_written_and_rendered(tmp_path):
 
 
 def test_not_enough_disk_space_is_reported_before_the_run(tmp_path):
-    with pytest.raises(OutputError, match="MB free"):
+    with pytest.raises(OutputError, match=r"the run's frames need about 1,000,000,000 GB but '.*' has [\d.,]+ [kMG]?B "
+                                          r"free \(the disk is full or nearly\)"):
         check_space(tmp_path, 10 ** 18)
 
 

@@ -4,10 +4,11 @@ gmsh meshes a surface without coming back to Python, where a Ctrl-C or SIGTERM w
 handled, for as long as the meshing takes (minutes for a size far too small); run in a
 forked child, the parent waits on a pipe, which a signal interrupts, and kills the child.
 
-The stop signals are held back while the child is forked (one that arrived inside the
-fork's own handlers, the logging module's, was dropped there), and the child is killed by
-the system when its parent dies however it dies (a parent killed outright left gmsh
-meshing on, a full core and its memory, holding its caller's pipes open).
+A stop signal that arrives while the child is forked is noted and raised after (one
+that arrived inside the fork's own hooks, the logging module's, was dropped there), and
+the child is killed by the system when its parent dies however it dies (a parent killed
+outright left gmsh meshing on, a full core and its memory, holding its caller's pipes
+open).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ..errors import MeshError
-from ..signals import STOP_SIGNALS
+from ..signals import STOP_SIGNALS, handling
 
 #: prctl's option that has the system send a signal to a process when its parent dies (Linux).
 PR_SET_PDEATHSIG = 1
@@ -33,11 +34,7 @@ def in_child(function: Callable[..., Any], *args: Any) -> Any:
     receive, send = context.Pipe(duplex=False)
     child = context.Process(target=_serve, args=(send, os.getpid(), function, args), daemon=True)
     try:
-        signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
-        try:
-            child.start()
-        finally:
-            signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)  # one held back is raised here, in the try
+        _start(child)
         send.close()
         succeeded, value = receive.recv()
     except EOFError:  # the child died without an answer (killed, out of memory)
@@ -52,6 +49,18 @@ def in_child(function: Callable[..., Any], *args: Any) -> Any:
     if succeeded:
         return value
     raise value
+
+
+def _start(child) -> None:
+    """Fork ``child``, a stop signal that arrives meanwhile only noted, and raised once the
+    fork is done. Raised while the fork runs its hooks (the logging module's), the
+    interrupt was printed as ignored there and lost; blocking the signal in this thread
+    is not enough, as another thread (a progress display's) may take it for the process."""
+    noted: list[int] = []
+    with handling({number: lambda number, frame: noted.append(number) for number in STOP_SIGNALS}):
+        child.start()
+    if noted:
+        signal.raise_signal(noted[0])  # to the handler the caller has
 
 
 def _die_with(parent: int) -> None:
@@ -72,7 +81,6 @@ def _serve(send, parent: int, function: Callable[..., Any], args: tuple) -> None
     _die_with(parent)
     for number in STOP_SIGNALS:
         signal.signal(number, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)  # the parent's mask while it forked
     try:
         outcome = (True, function(*args))
     except Exception as error:  # noqa: BLE001 - every failure is the parent's to raise

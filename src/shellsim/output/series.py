@@ -117,7 +117,8 @@ def _size(n_bytes: float) -> str:
     """'420 MB', '35 kB', '512 bytes'."""
     for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
         if n_bytes >= size:
-            return f"{n_bytes / size:,.3g} {unit}"
+            value = n_bytes / size
+            return f"{value:,.0f} {unit}" if value >= 100 else f"{value:.3g} {unit}"
     return f"{n_bytes:,.0f} bytes"
 
 

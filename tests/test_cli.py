@@ -78,13 +78,29 @@ def test_a_scene_that_would_take_years_is_refused_by_check_and_run(tmp_path):
     assert summary["status"] == "refused" and summary["steps"] == 0
 
 
-def test_a_mesh_larger_than_the_memory_is_refused_after_meshing(tmp_path, monkeypatch):
-    from shellsim.solver import outlook
+def test_a_mesh_larger_than_the_memory_is_refused_before_meshing(tmp_path, monkeypatch):
+    """A builder's divisions are counted before gmsh meshes them."""
+    from shellsim import memory
 
-    monkeypatch.setattr(outlook, "available_bytes", lambda: 1e8)
+    monkeypatch.setattr(memory, "available_bytes", lambda: 1e8)
     result = runner.invoke(app, ["check", str(ARTERY_DECK)])
     assert result.exit_code == 2
-    assert "the mesh has 19 elements: a run needs about 400 MB of memory and 100 MB is available" in \
+    assert "[mesh] divisions give 19 elements: a run needs about 400 MB of memory and 100 MB is available" in \
+        " ".join(result.output.split())
+
+
+def test_a_mesh_file_larger_than_the_memory_is_refused_once_read(tmp_path, monkeypatch):
+    """A mesh file's size is known once it is read: refused then, naming its elements."""
+    from shellsim import memory
+
+    from .conftest import pressed_plates_deck
+
+    deck = tmp_path / "plates.toml"
+    deck.write_text(pressed_plates_deck(tmp_path / "plates.vtu", 1.0, "[solver]\nend_time = 1.0"))
+    monkeypatch.setattr(memory, "available_bytes", lambda: 1e8)
+    result = runner.invoke(app, ["check", str(deck)])
+    assert result.exit_code == 2
+    assert "the mesh has 25 elements: a run needs about 400 MB of memory and 100 MB is available" in \
         " ".join(result.output.split())
 
 

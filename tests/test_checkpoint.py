@@ -222,7 +222,7 @@ def _places(data, path=()):
         yield from _places(item, (*path, key))
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=st.data())
 def test_a_damaged_checkpoint_is_restored_or_refused_never_a_traceback(stopped_cantilever, built_cantilever,
                                                                        tmp_path, data):

@@ -49,7 +49,7 @@ def _planted(hostile: str) -> str:
                                      f"<pressure>{xml_escape(hostile)}</pressure></surface_load></Loads>")
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(hostile=HOSTILE)
 def test_nothing_a_model_file_s_attributes_hold_plants_deck_text(tmp_path_factory, hostile):
     """Whatever the names hold, the written deck has the tables and keys of the same model
@@ -120,7 +120,7 @@ def _untouched(victim: Path, victims: Path) -> None:
     assert (victims / "kept.txt").read_text() == "the user's own folder\n"
 
 
-@settings(max_examples=10, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(files=st.sets(st.sampled_from(RUN_FILES)), folders=st.sets(st.sampled_from(RUN_FOLDERS)),
        dangling=st.booleans())
 def test_links_in_an_output_folder_never_let_a_run_write_outside_it(tmp_path_factory, files, folders, dangling):

@@ -442,6 +442,13 @@ def test_fibres_from_a_mesh_file_set_the_material_axes(tmp_path):
         build_model(parse_deck(text.replace('field = "fibre"', 'field = "fibres"')), mesh)
 
 
+def _guccione_plate(axes: str) -> str:
+    """A 2 x 1 plate in z = 0 of two elements, of Guccione's law with material ``axes``."""
+    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 2, width = 1 }")
+    return text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+                        f'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\naxes = {axes}')
+
+
 def test_a_fibre_direction_along_the_shell_normal_is_refused_with_where():
     """Fixed axes whose direction is the plate's normal gave every point the element's own
     first direction, silently: refused, naming the key, the points and elements and a
@@ -449,10 +456,7 @@ def test_a_fibre_direction_along_the_shell_normal_is_refused_with_where():
     from shellsim.deck import parse_deck
     from shellsim.model import build_model
 
-    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 2, width = 1 }")
-    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
-                        'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\n'
-                        'axes = { kind = "fixed", direction = DIRECTION }')
+    text = _guccione_plate('{ kind = "fixed", direction = DIRECTION }')
     deck = parse_deck(text.replace("DIRECTION", "[0.0, 0.0, 2.0]"))
     with pytest.raises(MeshError, match=r"material.axes.direction = \(0, 0, 2\) lies along the shell's normal at "
                                         r"\d+ of \d+ points, in elements 1, 2 \(element 1 at \(0.5, 0.5, 0\)\): "
@@ -472,10 +476,7 @@ def test_a_vessel_axis_lying_in_the_shell_is_refused_and_one_across_it_is_not():
     from shellsim.deck import parse_deck
     from shellsim.model import build_model
 
-    text = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "[mesh]\ndivisions = { length = 2, width = 1 }")
-    text = text.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
-                        'model = "guccione"\nC1 = 100.0\nC2 = 8.0\nC3 = 4.0\nC4 = 4.0\n'
-                        'axes = { kind = "cylindrical", axis = AXIS }')
+    text = _guccione_plate('{ kind = "cylindrical", axis = AXIS }')
     lying = parse_deck(text.replace("AXIS", "[1.0, 0.0, 0.0]"))
     with pytest.raises(MeshError, match=r"the cylindrical material.axes' circumferential direction lies along the "
                                         r"shell's normal at \d+ of \d+ points, in elements 1, 2 .* the axis lies in "

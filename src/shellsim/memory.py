@@ -40,5 +40,9 @@ def refuse_if_too_big(n_elements: int, what: str = "the mesh has") -> None:
 
 
 def size_text(n_bytes: float) -> str:
-    """'1.9 GB', '420 MB'."""
-    return f"{n_bytes / 1e9:.3g} GB" if n_bytes >= 1e9 else f"{n_bytes / 1e6:.3g} MB"
+    """'1.9 GB', '420 MB', '1,000,000,000 GB', '35 kB', '512 bytes'."""
+    for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n_bytes >= size:
+            value = n_bytes / size
+            return f"{value:,.0f} {unit}" if value >= 100 else f"{value:.3g} {unit}"
+    return f"{n_bytes:,.0f} bytes"

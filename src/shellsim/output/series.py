@@ -13,6 +13,7 @@ import numpy as np
 
 from ..deck.schema import Output
 from ..errors import OutputError
+from ..memory import size_text
 from ..solver.run import Listener, Run
 from .encoding import Encoding
 from .fields import cable_fields, cable_mesh, frame_fields, output_mesh
@@ -78,7 +79,7 @@ class FrameWriter(Listener):
         # HDF5 meeting a full disk mid-write leaves its file in a state that later crashes
         # the process: the room is made sure of first
         t = float(run.sim.state.t)  # a numpy scalar would be written as its repr
-        check_space(self.folder, 2 * self._bytes(point_data, cell_data) + FRAME_MARGIN, f"the frame at t = {t:.6g}")
+        check_space(self.folder, 2 * self._bytes(point_data, cell_data) + FRAME_MARGIN, f"the frame at t = {t:.6g} needs")
         written = [(series, point_data, cell_data) for series in self.series]
         if self.cable_series:
             written += [(series, *cable_fields(run.sim, self.cables)) for series in self.cable_series]
@@ -103,23 +104,14 @@ class FrameWriter(Listener):
             raise OutputError(failed)
 
 
-def check_space(folder: Path, needed: int, what: str = "the run's frames") -> None:
-    """Raise OutputError when ``folder``'s disk has less than the ``needed`` bytes that
-    ``what`` needs free."""
+def check_space(folder: Path, needed: int, what: str = "the run's frames need") -> None:
+    """Raise OutputError when ``folder``'s disk has less than ``needed`` bytes free;
+    ``what`` says what needs them, verb included."""
     free = shutil.disk_usage(folder).free
     if needed > free:
-        raise OutputError(f"{what} need{'s' if what.startswith('the frame ') else ''} about {_size(needed)} but "
-                          f"'{folder}' has {_size(free)} free (the disk is full or nearly): write fewer frames "
-                          "(output.interval) or fields (output.fields), or choose another --out")
-
-
-def _size(n_bytes: float) -> str:
-    """'420 MB', '35 kB', '512 bytes'."""
-    for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
-        if n_bytes >= size:
-            value = n_bytes / size
-            return f"{value:,.0f} {unit}" if value >= 100 else f"{value:.3g} {unit}"
-    return f"{n_bytes:,.0f} bytes"
+        raise OutputError(f"{what} about {size_text(needed)} but '{folder}' has {size_text(free)} free (the disk is "
+                          "full or nearly): write fewer frames (output.interval) or fields (output.fields), or "
+                          "choose another --out")
 
 
 class StoredSeries:

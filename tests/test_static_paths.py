@@ -11,6 +11,7 @@ import pytest
 
 from shellsim.deck import parse_deck
 from shellsim.solver.explicit import EXTERNAL, INTERNAL
+from shellsim.solver.stability import describe
 from shellsim.verify.analytic import sphere_inflation_path
 from shellsim.verify.check import check
 
@@ -154,6 +155,37 @@ def test_arc_length_lands_on_output_times_and_knots_and_holds_where_the_curve_do
     assert run.history["tip_deflection"][-1] == pytest.approx(half.history["tip_deflection"][-1], rel=1e-6)
     held = np.flatnonzero((times > 0.5) & (times <= 0.7))
     assert all(run.newton[i - 1].iterations == 0 for i in held)  # nothing to solve while the load holds
+
+
+def test_arc_length_gives_every_output_time_a_frame_and_stays_on_the_balloon_s_path():
+    """The balloon with a frame every 0.01 of the clock, over its pressure maximum (0.2467)
+    and down the far side: every output time has a frame of its own at its time, the
+    inner radius grows at every step (a load step onto an output time past the maximum
+    once turned the balloon inside out, -9.4 mm, and reported a jump), and the largest
+    pressure is the deck's reference."""
+    run = run_deck(_deck("balloon_limit_point_arc_length", {"times = [0.1, 0.2, 0.25]": "interval = 0.01"}))
+    assert run.status == "completed"
+    marks = np.append(np.arange(1, 29) * 0.01, 0.2867)
+    frames = np.asarray(run.frame_times[1:])
+    assert len(frames) == len(marks) and np.allclose(frames, marks, rtol=0.0, atol=1e-9)
+    assert np.all(np.diff(run.history["inner_radius"]) > 0.0)
+    assert [e["kind"] for e in run.stability.events()] == ["limit point"]
+    assert max(run.history["load_factor_ramp"]) == pytest.approx(0.2466586, rel=0.01)
+
+
+def test_a_path_that_comes_back_to_zero_load_ends_there_completed():
+    """The thin hinged roof (h = 6.35, a quarter of P = 1000 at the crown) snaps back so
+    far that its path returns to zero load; the ramp holds below load time 0, so the path
+    ends there: the run is completed with every step converged, its last frame at that
+    state, and it says where it ended and why, short of the end time."""
+    run = run_deck(_deck("hinged_roof_snap_4x4", {"thickness = 12.7": "thickness = 6.35", "-750.0": "-250.0",
+                                                  "end_time = 1.8": "end_time = 4.0"}))
+    assert run.status == "completed"
+    assert run.newton[-1].load_time == 0.0 and all(step.cutbacks == 0 for step in run.newton)
+    assert run.frame_times[-1] == run.times[-1] < 4.0
+    kinds = [e["kind"] for e in run.stability.events()]
+    assert kinds[0] == "limit point" and kinds[-1] == "unloaded"
+    assert "the run ends there, short of solver.end_time = 4" in describe(run.stability.events()[-1])
 
 
 def test_a_static_run_s_works_are_the_balloon_s_stored_energy():

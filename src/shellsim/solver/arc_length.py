@@ -21,8 +21,14 @@ until the first limit point and keeps rising after it, so histories and frames s
 order; the load reached is the history's load factor. Where the next output time or a
 knot of a load curve is within the next arc's reach, the step goes there by a load step
 instead (Newton at that load time), so frames land on their times and no step straddles
-a kink of a curve; where the curves hold (or have ended), the load time moves on to where
-they change again with nothing to solve.
+a kink of a curve. Such a load step counts only where it stays on the path: one that
+moves the shape more than LANDING_REACH arcs found another equilibrium at that load (a
+balloon past its pressure maximum turned inside out) and is undone. No arc passes an
+output time either (it is taken again shorter), so each output time has a frame of its
+own, at its time wherever a load step reaches it and just past it where a limit point
+lies between. Where the curves hold (or have ended), the load time moves on to where
+they change again with nothing to solve; where the path comes back to loads that no
+longer change (a structure unloaded along it), the run ends there.
 """
 
 from __future__ import annotations
@@ -47,6 +53,9 @@ MOST_TURN = 0.15
 #: Steps in a row that move the clock by less than STALL of the end time end the run: the
 #: path makes no progress.
 STALLED_STEPS, STALL = 50, 1e-9
+#: The most a load step onto an output time or knot may move the translations, in arcs
+#: of the current length: further, and it left the path for another equilibrium.
+LANDING_REACH = 2.0
 
 
 class LoadRate:
@@ -134,10 +143,13 @@ class ArcLength:
     def moved(self, before: Converged) -> None:
         """The state has converged at ``self.load_time`` from ``before`` by other means
         (a load step, a hold): the path's direction is that move's."""
-        u = self.eq.unknowns
-        sim = self.newton.run.sim
-        change = u.gather(u.to_local(sim.state.x - before.arrays["x"], sim.state.theta - before.arrays["theta"]))
-        self._follow(change[:u.n_free][self.translation])
+        self._follow(self._translations(before))
+
+    def _translations(self, before: Converged) -> np.ndarray:
+        """The free translations (n_translations,) from ``before`` to the state."""
+        u, s = self.eq.unknowns, self.newton.run.sim.state
+        change = u.gather(u.to_local(s.x - before.arrays["x"], s.theta - before.arrays["theta"]))
+        return change[:u.n_free][self.translation]
 
     def _follow(self, translations: np.ndarray) -> None:
         """The last step's translations (n_translations,): its turn from the one before."""
@@ -147,11 +159,12 @@ class ArcLength:
         if np.any(translations):
             self.direction = translations
 
-    def step(self, length: float, stop: float) -> tuple[int, float, float]:
+    def step(self, length: float, stop: float, room: float = np.inf) -> tuple[int, float, float]:
         """Equilibrium a translational distance ``length`` along the path; returns
         (iterations, relative residual, change of load time). Raises NotConverged when it
-        does not converge, converges pointing back along the path, or passes the load
-        time ``stop`` (a knot); the state is then wherever the iterations left it."""
+        does not converge, converges pointing back along the path, passes the load time
+        ``stop`` (a knot) or moves the clock more than ``room`` (past an output time); the
+        state is then wherever the iterations left it."""
         eq, newton, m = self.eq, self.newton, self.translation
         start = t = self.load_time
         eq.evaluate(t)
@@ -176,6 +189,8 @@ class ArcLength:
             if newton.converged(norm, scale, energy, scale * length, floor):
                 if (t - stop) * (start - stop) < 0.0:
                     raise NotConverged(f"the step passed load time {stop:.6g}, a knot of a load curve")
+                if abs(t - start) > room * (1.0 + 1e-9):
+                    raise NotConverged("the step passed an output time")
                 if self.direction is not None and total[m] @ self.direction < 0.0:
                     raise NotConverged("the step turned back along the path it came by")
                 newton.held_apart(t)
@@ -195,16 +210,25 @@ class ArcLength:
 
     def land(self, stop: float, length: float) -> NewtonStep | None:
         """A load step to the load time ``stop`` when the next arc of ``length`` would
-        reach it (by the last step's load per length); None when it would not, or the load
-        step does not converge (a limit point before it): the state is then as before."""
+        reach it (by the last step's load per length); None when it would not, when the
+        load step does not converge (a limit point before it) or when it moves the shape
+        further than LANDING_REACH arcs (to another equilibrium, off the path): the state
+        is then as before."""
         if abs(stop - self.load_time) > self.load_per_length * length:
             return None
-        sim, before = self.newton.run.sim, self.eq.converged
+        newton, before = self.newton, self.eq.converged
+        noted = len(newton.stability.noted)
         try:
-            iterations, tangents, residual = self.newton.step(stop)
+            iterations, tangents, residual = newton.step(stop)
         except NotConverged:
-            before.restore(sim)
+            newton.back_to_converged()
             return None
+        moved = self._translations(before)
+        if np.linalg.norm(moved) > LANDING_REACH * length:
+            newton.back_to_converged()  # another equilibrium at that load, off the path: no jump of it
+            del newton.stability.noted[noted:]
+            return None
+        sim = newton.run.sim
         change, self.load_time = stop - self.load_time, stop
         self.forward = 1.0 if change >= 0.0 else -1.0
         self.moved(before)
@@ -220,16 +244,17 @@ class ArcLength:
         return NewtonStep(t=self.newton.run.sim.state.t + change, load_time=self.load_time, iterations=0,
                           tangents=0, residual=0.0, cutbacks=0)
 
-    def reach(self, length: float, first: float, stop: float) -> tuple[NewtonStep, float]:
+    def reach(self, length: float, first: float, stop: float, room: float) -> tuple[NewtonStep, float]:
         """A converged step from the converged state, tried at ``length`` and cut back
-        until it converges short of the load time ``stop``; returns the step (its clock t
-        past the state's by the change of load time) and the length it was taken at.
+        until it converges short of the load time ``stop`` and moves the clock by no more
+        than ``room``; returns the step (its clock t past the state's by the change of load
+        time) and the length it was taken at.
         Raises NumericalError when the length falls below ``min_increment`` of the ``first``."""
         sim = self.newton.run.sim
         cutbacks = 0
         while True:
             try:
-                iterations, residual, change = self.step(length, stop)
+                iterations, residual, change = self.step(length, stop, room)
                 return NewtonStep(t=sim.state.t + abs(change), load_time=self.load_time, iterations=iterations,
                                   tangents=iterations, residual=residual, cutbacks=cutbacks), length
             except NotConverged as why:
@@ -264,9 +289,10 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
     """Arc-length steps from the converged state until the clock (the load time's path
     length) passes the end time; a frame after each step that passes an output time.
     The first step is as long as the linear response to the first load step of
-    ``solver.static.increments``; no later step is longer than LONGEST of it. Raises
-    NumericalError where a step cannot be solved, where the path runs back to loads that
-    no longer change, or after STALLED_STEPS steps that barely move the clock."""
+    ``solver.static.increments``; no later step is longer than LONGEST of it. Where the
+    path comes back to loads that no longer change, the run ends there with a frame and
+    says so (:meth:`.stability.StabilityWatch.unloaded`). Raises NumericalError where a
+    step cannot be solved, or after STALLED_STEPS steps that barely move the clock."""
     sim, end = run.sim, run.deck.solver.end_time
     arc = ArcLength(newton)
     first = length = None
@@ -274,20 +300,21 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
     stalled = 0
     while sim.state.t < end - 1e-12 * end:
         before = sim.state.t
+        to_mark = marks[marks > before + 1e-12 * end][0] - before  # the marks end at the end time
         held = arc.hold_end()
         if held is not None:
             if arc.forward < 0.0 and np.isinf(held):
-                raise NumericalError(f"the path turned back to load time {arc.load_time:.6g} (clock t = "
-                                     f"{before:.6g}), below which the loads do not change: arc length cannot "
-                                     "follow it further")
-            step = arc.hold(held, marks[marks > before + 1e-12 * end][0] - before)  # marks end at the end time
+                newton.stability.unloaded(before, arc.load_time, end)
+                _frame(run, listener)
+                return
+            step = arc.hold(held, to_mark)
         else:
             if first is None:
                 first = length = arc.first_length(end / run.deck.solver.static.increments)
             stop = arc.next_stop(before, marks)
             step = arc.land(stop, length)
             if step is None:
-                step, length = arc.reach(length, first, arc.next_knot())
+                step, length = arc.reach(length, first, arc.next_knot(), to_mark)
                 if step.cutbacks == 0:
                     length = length * float(np.clip(np.sqrt(AIM / max(step.iterations, 1)), *GROWTH))
                 length = min(length, LONGEST * first, length * MOST_TURN / max(arc.turn, 1e-300))

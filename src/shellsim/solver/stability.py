@@ -30,7 +30,7 @@ class StabilityWatch:
 
     def __init__(self):
         self.observations: list[Observation] = []
-        self.jumps: list[dict] = []
+        self.noted: list[dict] = []  # the events the solver reports itself (jumps, the path unloaded)
 
     def observe(self, t: float, load_time: float, negative_pivots: int | None) -> None:
         """Record the count at the converged state at clock t (None: unknown, the factors
@@ -43,15 +43,22 @@ class StabilityWatch:
         """Record a load step from the converged state at clock t that moved the shape
         ``ratio`` times as far as its tangent predicted: it may have jumped over a
         snap-through, which it did not follow."""
-        self.jumps.append({"kind": "jump", "t_from": t, "load_time_from": load_time_from,
+        self.noted.append({"kind": "jump", "t_from": t, "load_time_from": load_time_from,
                            "load_time_to": load_time_to, "ratio": ratio})
+
+    def unloaded(self, t: float, load_time: float, end_time: float) -> None:
+        """Record that the path came back, at clock t, to the load time below which the
+        loads do not change: it ends there, short of the clock's ``end_time``."""
+        self.noted.append({"kind": "unloaded", "t_from": t, "t_to": t, "load_time_from": load_time,
+                           "load_time_to": load_time, "end_time": end_time})
 
     def events(self) -> list[dict]:
         """Each change of the count: the converged states it lies between (clock and load
         time), the counts before and after, and its kind, 'limit point' where the load's
         change turns back within a step of it, 'bifurcation' where the count rises with no
-        such turn, 'restabilised' where it falls with none; and each 'jump' (:meth:`jumped`),
-        in the order of their load times."""
+        such turn, 'restabilised' where it falls with none; each 'jump' (:meth:`jumped`)
+        and the path's return to loads that hold, 'unloaded' (:meth:`unloaded`), in the
+        order of their clock times."""
         seen, found = self.observations, []
         for i in range(1, len(seen)):
             before, after = seen[i - 1], seen[i]
@@ -65,7 +72,7 @@ class StabilityWatch:
             found.append({"kind": kind, "t_from": before.t, "t_to": after.t, "load_time_from": before.load_time,
                           "load_time_to": after.load_time, "negative_pivots_from": before.negative_pivots,
                           "negative_pivots_to": after.negative_pivots})
-        return sorted(found + self.jumps, key=lambda event: event["t_from"])
+        return sorted(found + self.noted, key=lambda event: event["t_from"])
 
 
 def describe(event: dict) -> str:
@@ -75,6 +82,10 @@ def describe(event: dict) -> str:
         return (f"jump {where}: the load step moved the shape {event['ratio']:.3g} times as far as the tangent at "
                 "its start predicted, so the path may snap through there, passed by a jump rather than followed; "
                 "solver.static.control = \"arc_length\" follows it")
+    if event["kind"] == "unloaded":
+        return (f"the path came back to load time {event['load_time_from']:.6g} at clock t = {event['t_from']:.6g}, "
+                f"and the loads do not change below it: the run ends there, short of solver.end_time = "
+                f"{event['end_time']:.6g}, with every step converged")
     counts = f"{event['negative_pivots_from']} -> {event['negative_pivots_to']} negative pivots"
     if event["kind"] == "bifurcation" and event["negative_pivots_from"] == 0:
         return (f"bifurcation passed {where} ({counts}): the tangent stiffness is no longer positive definite, "

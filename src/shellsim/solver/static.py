@@ -253,10 +253,10 @@ class NewtonSolver:
         try:
             return self.step(t)
         except NotConverged:
-            self._back_to_converged()
+            self.back_to_converged()
             return self.step(t, line_search=True)
 
-    def _back_to_converged(self) -> None:
+    def back_to_converged(self) -> None:
         """The last converged state again, and no tangent: one formed there may lie far
         from the path."""
         self.eq.converged.restore(self.run.sim)
@@ -308,7 +308,7 @@ class NewtonSolver:
                                   residual=residual, cutbacks=cutbacks)
                 return step, length
             except NotConverged as why:
-                self._back_to_converged()
+                self.back_to_converged()
                 cutbacks += 1
                 length = min(length, remaining) * CUT
                 if length < self.settings.min_increment * end:

@@ -203,10 +203,13 @@ class Static(Section):
     ``min_increment`` of the first), and shorter after a step where the path turned
     sharply. A step that converges pointing back along the path is taken again shorter.
     Where an output time or a knot of a load curve is within the next step's reach, a load
-    step goes there instead; where the curves hold or have ended, the load time moves on
-    with nothing to solve. The run's clock is then the load time's path length (the load
-    time until the first limit point); it ends at the first step that reaches ``end_time``,
-    and history.csv's load factors tell the load reached."""
+    step goes there instead (undone where it lands on another equilibrium, more than two
+    steps away); no step passes an output time, so each has a frame of its own; where the
+    curves hold or have ended, the load time moves on with nothing to solve. The run's
+    clock is then the load time's path length (the load time until the first limit
+    point); it ends at the first step that reaches ``end_time``, or where the path comes
+    back to loads that no longer change (reported as ``unloaded`` in
+    ``static.stability``), and history.csv's load factors tell the load reached."""
 
     control: Literal["load", "arc_length"] = "load"
     newton: Literal["modified", "full"] = "modified"

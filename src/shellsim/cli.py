@@ -97,6 +97,7 @@ def check(deck: DeckPath) -> None:
     step count will be."""
     from .deck import load_deck
     from .execute import sized_mesh
+    from .geometry.crossings import crossing_problem
     from .model import build_model
     from .plan import plan
     from .solver.outlook import refuse_if_hopeless, static_outlook, step_outlook
@@ -115,6 +116,10 @@ def check(deck: DeckPath) -> None:
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if not static:
         refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
+    with err.status("looking for parts that pass through each other"):
+        crossing = crossing_problem(mesh.x, mesh.conn)
+    if crossing:
+        err.print(f"[yellow]warning:[/] {shown(crossing)}", highlight=False)
     if not static and scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(
             f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "

@@ -44,6 +44,25 @@ def test_a_static_solve_whose_first_tangent_is_singular_stops_naming_the_node(tm
     assert summary["status"] == "not converged" and "nodes 10" in summary["message"]
 
 
+def test_check_warns_of_a_node_that_hangs_on_a_slack_chord_alone(tmp_path):
+    """`check` of the same deck says beforehand that node 10 hangs on the chord alone and
+    what to do; with the chord's end held across it (the model as written) it says
+    nothing of it."""
+    def checked(text: str) -> str:
+        model = tmp_path / "tethered.feb"
+        model.write_text(text)
+        done = import_model(model, tmp_path / f"imported{len(text)}")
+        result = runner.invoke(app, ["check", str(done.deck)])
+        assert result.exit_code == 0, result.output
+        return " ".join(result.output.split())
+
+    held = tethered_plate_feb("4.0")
+    said = checked(held.replace(feb_held("4.0", "Across", "End", "yz"), ""))
+    assert "warning: 1 node(s) hang on cables alone with none of their chords in tension at the start: nodes 10 " \
+           "(the first at (2, 0, 0))" in said and "rest_length < 1" in said
+    assert "hang on cables" not in checked(held)
+
+
 def test_principal_stresses_of_a_state_gone_to_no_number_are_no_number():
     """The breaking frame of a run whose stresses went NaN: the principal stresses there
     are NaN, those of the finite stresses beside them their eigenvalues, and nothing

@@ -116,6 +116,8 @@ def check(deck: DeckPath) -> None:
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if not static:
         refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
+    if scene.solver.ramp_end is not None:  # a static solve, or a static preload
+        _warn_of_hanging_nodes(scene, mesh, model)
     with err.status("looking for parts that pass through each other"):
         crossing = crossing_problem(mesh.x, mesh.conn)
     if crossing:
@@ -132,6 +134,22 @@ def check(deck: DeckPath) -> None:
             "puts the time step above the critical step: the run will be unstable"
         )
     out.print(f"[green]ok[/] {deck}")
+
+
+def _warn_of_hanging_nodes(scene, mesh, model) -> None:
+    """Warn of nodes that hang on untensioned cables alone: the static tangent has no
+    stiffness across their chords at the start, and the first load step stops there."""
+    from .errors import id_list, place
+    from .loads.cable import untensioned_hanging_nodes
+
+    nodes = untensioned_hanging_nodes(scene.cable, mesh, model.constraints.projector)
+    if len(nodes):
+        text = (f"{len(nodes)} node(s) hang on cables alone with none of their chords in tension at the start: "
+                f"nodes {id_list(nodes + 1)} (the first at {place(mesh.x[nodes[0]])}). A chord at rest has no "
+                "stiffness across it, so the static solve's first tangent is singular there: hold them with a "
+                "[[boundary]], give their cables rest_length < 1 (a pre-tension), or solve explicitly "
+                "(solver.method = \"explicit\")")
+        err.print(f"[yellow]warning:[/] {shown(text)}", highlight=False)
 
 
 def _compiles_shown(status):

@@ -91,6 +91,26 @@ class Cable(LoadTable):
 TABLES = (Cable,)
 
 
+def untensioned_hanging_nodes(tables: list[Cable], mesh: Mesh, projector: np.ndarray) -> np.ndarray:
+    """The nodes (k,) that hang on ``tables``' chords alone with none of them in tension at
+    the start (rest length at least the initial one), on no shell element, and free to
+    move (their support projector (n, 3, 3)) in some direction across every chord they
+    end: a string at rest is stiff only along itself, so a static tangent is singular
+    there until the chords are stretched."""
+    on_chords = [mesh.lines[mesh.sets[t.elements].elements] for t in tables]
+    tensioned = [chords.ravel() for t, chords in zip(tables, on_chords) if t.rest_length < 1.0]
+    chords = np.concatenate(on_chords or [np.zeros((0, 2), dtype=np.int64)])
+    candidates = np.setdiff1d(chords.ravel(), np.concatenate([mesh.conn.ravel(), *tensioned]))
+    along = mesh.x[chords[:, 1]] - mesh.x[chords[:, 0]]
+    hanging = []
+    for node in candidates:
+        free = projector[node]
+        stiff = free @ along[(chords == node).any(axis=1)].T  # each chord's direction, as far as it is free
+        if np.linalg.matrix_rank(stiff, tol=1e-9 * np.abs(stiff).max(initial=1.0)) < np.linalg.matrix_rank(free):
+            hanging.append(node)
+    return np.asarray(hanging, dtype=np.int64)
+
+
 def extend_mesh(table: Cable, mesh: Mesh) -> Mesh:
     """``mesh`` with ``table``'s chords: their new nodes appended (directors along the
     chord, no thickness, 0 in the point fields), their elements appended to ``mesh.lines``,

@@ -139,7 +139,7 @@ def test_deck_values_that_can_only_be_mistakes_are_refused_naming_the_key(tmp_pa
     assert "contact[0].friction" in problems_of(plates) and "less than or equal to 2" in problems_of(plates)
     timed = pressed_plates_deck(tmp_path / "plates.vtu", 1.0, "[solver]\nend_time = 1.0").replace(
         'name = "between"', 'name = "time"')
-    assert "contact[0].name: 'time' is already a history column" in problems_of(timed)
+    assert "contact[0].name: 'time' is one of history.csv's own columns" in problems_of(timed)
     probed = timed.replace('name = "time"', 'name = "between"') + (
         '\n[[output.probe]]\nname = "kinetic_energy"\nquantity = "displacement"\nset = "upper"\ncomponent = "z"\n')
     assert "output.probe[0].name: 'kinetic_energy' is one of history.csv's own columns" in problems_of(probed)
@@ -245,7 +245,8 @@ def test_a_static_summary_states_the_load_reached_and_the_largest_on_the_way():
 
     steps = [NewtonStep(t=t, load_time=load, iterations=3, tangents=1, residual=1e-8, cutbacks=0)
              for t, load in ((0.1, 0.1), (0.3, 0.3), (0.4, 0.2))]
-    run = SimpleNamespace(newton=steps, stability=None, load_factors={"load_factor_ramp": 0},
+    factors = SimpleNamespace(columns=["load_factor_ramp"])
+    run = SimpleNamespace(newton=steps, stability=None, measure={"load_factors": factors}.get,
                           history={"load_factor_ramp": [0.0, 0.1, 0.3, 0.2]})
     record = static_record(run)
     assert (record["load_time_reached"], record["largest_load_time"]) == (0.2, 0.3)

@@ -13,7 +13,7 @@ import pytest
 from shellsim.deck import parse_deck
 from shellsim.deck.schema import Valve
 from shellsim.mesh import NamedSet
-from shellsim.solver.valve import fill_triangles, largest_principal, resolve_valve
+from shellsim.solver.measures.valve import fill_triangles, largest_principal, resolve_valve
 
 from .conftest import PLATE_THICKNESS, deck_text, pressed_plates, prepared, problems_of, run_deck
 
@@ -78,7 +78,7 @@ def test_the_valve_builder_s_leaflets_leave_an_opening_their_thickness_narrows(t
     centre: it is the solids' shadow that closes the orifice, not the mid-surfaces'."""
     deck = parse_deck(deck_text(VALVE, VALVE_OUTPUT).replace("thickness = 0.01", f"thickness = {thickness}"))
     run = prepared(deck)
-    measures = run.valve(run.sim)
+    measures = run.measure("valve")(run.sim)
     pixel = 2.0 * 12.0 / 2000  # the annulus is the root's base, 24 across
     centre = 2 * 0.55 / math.sqrt(3) - thickness
     if centre > 0.0:
@@ -130,7 +130,7 @@ value = {-s}
 annulus = "x1"
 ''').replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0'))
     run = run_deck(deck)
-    measures = run.valve(run.sim)
+    measures = run.measure("valve")(run.sim)
     assert measures["peak_principal_stress"] == pytest.approx(s, rel=1e-4)
     assert measures["orifice_area"] == 0.0
 
@@ -147,7 +147,8 @@ def test_a_valve_table_naming_what_the_scene_lacks_is_refused(table, expected):
 
 def test_a_probe_named_like_a_valve_measure_is_refused():
     probe = '[[output.probe]]\nname = "orifice_area"\nquantity = "displacement"\nset = "centre_1"\ncomponent = "z"\n'
-    assert "'orifice_area' is already a probe's" in problems_of(deck_text(VALVE, probe + VALVE_OUTPUT))
+    assert ("output.probe[0].name: 'orifice_area' is already a history column, a valve measure's (output.valve)"
+            in problems_of(deck_text(VALVE, probe + VALVE_OUTPUT)))
 
 
 def test_the_largest_principal_value_is_eigvalsh_s_largest():
@@ -164,4 +165,4 @@ def test_a_state_with_no_numbers_measures_nothing_rather_than_failing():
     measures are nan then, and the check names the breakdown."""
     run = prepared(parse_deck(deck_text(VALVE, VALVE_OUTPUT)))
     run.sim.state.x[0] = np.nan
-    assert all(math.isnan(value) for value in run.valve(run.sim).values())
+    assert all(math.isnan(value) for value in run.measure("valve")(run.sim).values())

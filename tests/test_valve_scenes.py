@@ -67,7 +67,7 @@ def test_the_closed_valve_s_measures_are_a_closed_valve_s(closing):
     there carries p A / (L h) or more."""
     run, folder = closing
     valve = json.loads((folder / "summary.json").read_text())["valve"]
-    ring = run.model.x0[run.valve.annulus] @ run.valve.frame[:2].T
+    ring = run.model.x0[run.measure("valve").annulus] @ run.measure("valve").frame[:2].T
     pixel = np.ptp(ring, axis=0).max() / 400
     assert valve["regurgitant_gap"]["final"] <= 2 * pixel * (1 + 1e-12)
     assert 2.0 < valve["coaptation_height"]["final"] < 14.0

@@ -9,26 +9,9 @@ from __future__ import annotations
 
 import difflib
 
-from ..loads import DECK_KEYS, measure_names
+from ..loads import DECK_KEYS
+from .columns import column_clashes, measured_columns
 from .schema import Deck
-
-
-#: The energies' columns of history.csv, in the order of the time loop's energy indices;
-#: the last, friction's, only where a contact has friction.
-ENERGY_COLUMNS = ("internal_energy", "kinetic_energy", "external_work", "damping_work", "friction_work")
-#: The columns every history.csv has: no probe, contact or measure may take their names.
-OWN_COLUMNS = ("time", "dt", *ENERGY_COLUMNS)
-
-
-def load_factor_columns(deck: Deck) -> dict[str, int]:
-    """The history columns of the curves' factors at the load time, each with its curve's
-    index in the model's tables: ``load_factor_<curve>`` for every deck curve, and
-    ``load_factor`` for the ramp that the loads without a curve of a static solve or a
-    preload follow."""
-    columns = {f"load_factor_{name}": deck.curve_index(name) for name in deck.curves}
-    if deck.solver.ramp_end is not None:
-        columns["load_factor"] = deck.curve_index(None)
-    return columns
 
 
 def did_you_mean(word: str, choices: list[str] | tuple[str, ...]) -> str:
@@ -98,34 +81,14 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
             for name_key, name in table.named_sets.items():
                 need_set(f"{key}[{i}].{name_key}", name, table.SET_KINDS)
             need_curve(f"{key}[{i}].curve", getattr(table, "curve", None))
-    factors = list(load_factor_columns(deck))
-    columns = factors + [p.name for p in deck.output.probe]
-    problems += [f"output.probe[{i}].name: '{probe.name}' is one of history.csv's own columns "
-                 f"({', '.join(OWN_COLUMNS)}); choose another name"
-                 for i, probe in enumerate(deck.output.probe) if probe.name in OWN_COLUMNS]
-    columns += OWN_COLUMNS
-    for i, contact in enumerate(deck.contact):
-        for column in measure_names([contact.name]):
-            if column in columns:
-                problems.append(f"contact[{i}].name: '{column}' is already a history column (the history's own, a "
-                                "probe's, a curve's load factor or a contact's); choose another name")
-            columns.append(column)
+    problems += column_clashes(deck)
     valve = deck.output.valve
     if valve is not None:
         need_set("output.valve.leaflets", valve.leaflets, ("surface",))
         need_set("output.valve.annulus", valve.annulus, ("edge", "point"))
-        for column in valve.COLUMNS:
-            if column in columns:
-                problems.append(f"output.valve: its history column '{column}' is already a probe's, a curve's load "
-                                "factor's or a contact's; rename that one")
-            columns.append(column)
     for i, probe in enumerate(deck.output.probe):
         need_set(f"output.probe[{i}].set", probe.set)
-        if probe.name in factors:
-            problems.append(f"output.probe[{i}].name: '{probe.name}' is the history's column of a curve's load "
-                            "factor; choose another name")
-    probes = [p.name for p in deck.output.probe] + factors + measure_names([c.name for c in deck.contact])
-    probes += list(valve.COLUMNS) if valve is not None else []
+    probes = [column.name for column in measured_columns(deck)]
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:
             problems.append(

@@ -157,6 +157,11 @@ def calibrate(model, masses: np.ndarray, rotary: np.ndarray, dt: float) -> None:
         kind.calibrate(bundle, masses, rotary, model.h0, dt)
 
 
+def needs_calibration(model) -> bool:
+    """Whether some kind of ``model`` has penalty springs for :func:`calibrate` to set."""
+    return bool(_with(model, "calibrate"))
+
+
 def step_share(model) -> float:
     """The share of the structure's critical step that stays stable with every penalty."""
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)

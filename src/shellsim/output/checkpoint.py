@@ -131,6 +131,14 @@ def _numbers(watch) -> dict:
             if isinstance(value, (int, float)) or value is None}
 
 
+def _watches(run: Run) -> dict:
+    """The objects of ``run`` that keep plain numbers between samples, by name: a
+    relaxation's watch for rest, and each measure family that has some (a valve's next
+    measurement time)."""
+    watching = {"relaxing": run.relaxing} if run.relaxing is not None else {}
+    return watching | {measure.NAME: measure for measure in run.measures if _numbers(measure)}
+
+
 def fingerprint(run: Run) -> str:
     """A hash of the scene ``run`` was built from: its resolved deck and its mesh."""
     digest = hashlib.sha256(json.dumps(run.deck.model_dump(mode="json"), sort_keys=True).encode())
@@ -147,8 +155,7 @@ def snapshot(run: Run) -> dict:
             "arrays": [array.copy() for array in _carried(run)],
             "eigenvector": sim._eigenvector, "fresh": sim._fresh.bit_generator.state, "mass_factor": sim.mass_factor,
             "record": {name: getattr(run, name) for name in RECORD}, "frame_times": [*run.frame_times, state.t],
-            "watches": {name: _numbers(getattr(run, name)) for name in ("relaxing", "valve")
-                        if getattr(run, name) is not None}}
+            "watches": {name: _numbers(watch) for name, watch in _watches(run).items()}}
 
 
 def _encoded(value, arrays: list[np.ndarray]):
@@ -219,9 +226,9 @@ def _check_fits(run: Run, saved: dict) -> None:
         raise ValueError("its clock, estimator or watches are not a run's")
     if saved["eigenvector"] is not None and saved["eigenvector"].shape != (5 * run.model.n_nodes,):
         raise ValueError("its estimator's vector is not the scene's")
+    watches = _watches(run)
     for name, numbers in saved["watches"].items():
-        if name not in ("relaxing", "valve") or getattr(run, name) is None or not numbers.keys() <= vars(
-                getattr(run, name)).keys():
+        if name not in watches or not numbers.keys() <= vars(watches[name]).keys():
             raise ValueError(f"its watch {name!r} is not the scene's")
     record = saved["record"]
     if not isinstance(record, dict) or record.keys() != set(RECORD):
@@ -255,8 +262,9 @@ def restore(run: Run, saved: dict) -> None:
     for name, value in saved["record"].items():
         setattr(run, name, value)
     run.frame_times = [float(t) for t in saved["frame_times"]]
+    watches = _watches(run)
     for name, numbers in saved["watches"].items():
-        vars(getattr(run, name)).update(numbers)
+        vars(watches[name]).update(numbers)
 
 
 def _regular_file_bytes(path: Path) -> bytes:

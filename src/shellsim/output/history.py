@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..deck.references import ENERGY_COLUMNS
+from ..deck.columns import ENERGY_COLUMNS
 from ..errors import OutputError
 from ..solver.explicit import FRICTION
 from ..solver.run import Listener, Run

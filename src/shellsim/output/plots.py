@@ -1,5 +1,6 @@
-"""Line plots of a finished run (matplotlib, no display needed): each probe's and valve
-measure's history against time, and against the load when one load follows a time curve
+"""Line plots of a finished run (matplotlib, no display needed): each measured column that
+has a quantity of its own (:mod:`shellsim.deck.columns`: a probe's, a valve measure's)
+against time, and against the load when one load follows a time curve
 (load-displacement curves such as the thesis' Figures 4.29 and 4.33), with the deck's
 references drawn on them; and the energies."""
 
@@ -10,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..deck.references import ENERGY_COLUMNS
+from ..deck.columns import ENERGY_COLUMNS, measured_columns
 from ..deck.resolved import read_resolved
 from .folder import output_folder, refuse_link, replacing
 from .history import read_history
@@ -51,7 +52,7 @@ def _load_axis(deck, times: np.ndarray, units: DisplayUnits) -> tuple[np.ndarray
 
 
 def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
-    """PNGs of every probe's and valve measure's history (``<name>.png``) and of the energies
+    """PNGs of every plotted measure's history (``<name>.png``: probes, valve measures) and of the energies
     (``energy.png``) in ``out_dir`` (default ``folder/plots``). Returns the files written.
     Text from the deck is drawn as written: a '$' in a title is not TeX to parse."""
     from matplotlib import rc_context
@@ -70,9 +71,8 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
     load = _load_axis(deck, times, units)
     whole = _completed(folder)  # a run cut short is judged, and drawn, only at the times it reached
     written = []
-    valve = deck.output.valve.COLUMNS if deck.output.valve is not None else {}
-    for name, quantity in [(probe.name, probe.quantity) for probe in deck.output.probe] + list(valve.items()):
-        measured = ~np.isnan(history[name])  # a valve's measures are taken at some samples only
+    for name, quantity in [(c.name, c.quantity) for c in measured_columns(deck) if c.quantity is not None]:
+        measured = ~np.isnan(history[name])  # some measures (a valve's) are taken at some samples only
         scale = units.scale(quantity)
         t, values = times[measured], scale * history[name][measured]
         figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")

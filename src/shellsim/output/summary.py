@@ -1,5 +1,6 @@
 """summary.json: what was run, how long it took, the energy balance, what the scene used
-and left out, a valve's measures and each reference check."""
+and left out, each measure family's entry (contact's cost, a valve's measures) and each
+reference check."""
 
 from __future__ import annotations
 
@@ -13,21 +14,21 @@ from .. import __version__
 from ..plan import Plan
 from ..solver.explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC
 from ..solver.run import Run, dt_statistics
-from ..solver.valve import VALVE_COLUMNS
 from ..verify.check import check
 from .folder import write_atomically
 
 
 def reference_results(run: Run) -> list[dict]:
-    """One entry per [reference] of the deck, from the recorded histories: a valve
-    measure's from the samples it was taken at. A run that did not complete has only its
+    """One entry per [reference] of the deck, from the recorded histories: a measure
+    taken at some samples only (a valve's) from those samples. A run that did not complete has only its
     ``at_time`` values judged: a final value, an extreme or a peak over a run cut short
     is not the run's, so those are not judged (``passed`` None, with a note saying why)."""
     times = np.asarray(run.times)
+    sparse = {column for measure in run.measures if measure.sparse for column in measure.columns}
     results = []
     for ref in run.deck.reference:
         values = np.asarray(run.history[ref.probe])
-        taken = ~np.isnan(values) if ref.probe in VALVE_COLUMNS else slice(None)
+        taken = ~np.isnan(values) if ref.probe in sparse else slice(None)
         entry = check(ref, times[taken], values[taken])
         if run.status != "completed" and ref.measure != "at_time":
             entry |= {"computed": None, "error": None, "error_percent": None, "passed": None,
@@ -78,8 +79,8 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "features": {"used": plan.used(), "left_out": plan.left_out()},
         **large_strain,
         **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
-        **({"contact": contact_record(run, output_seconds)} if run.tool_forces is not None else {}),
-        **({"valve": valve_record(run)} if run.valve is not None else {}),
+        **{measure.NAME: entry for measure in run.measures
+           if (entry := measure.record(run, output_seconds)) is not None},
         **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0)}}
            if run.deck.solver.mass_scaling is not None else {}),
         **({"relaxation": run.relaxing.record(run.sim)} if run.relaxing is not None else {}),
@@ -103,36 +104,15 @@ def static_record(run: Run) -> dict:
     short of its load) with each curve's largest load factor, each step, and where the
     path lost or regained stability (:meth:`.stability.StabilityWatch.events`)."""
     steps = [vars(step) for step in run.newton]
+    factors = run.measure("load_factors").columns if run.measure("load_factors") else []
     return {"load_steps": len(steps), "iterations": sum(s["iterations"] for s in steps),
             "load_time_reached": steps[-1]["load_time"] if steps else 0.0,
             "largest_load_time": max((s["load_time"] for s in steps), default=0.0),
-            "largest_load_factors": {column: max(run.history[column], default=0.0) for column in run.load_factors},
+            "largest_load_factors": {column: max(run.history[column], default=0.0) for column in factors},
             "tangents": sum(s["tangents"] for s in steps),
             "cutbacks": sum(s["cutbacks"] for s in steps),
             "largest_residual": max((s["residual"] for s in steps), default=0.0),
             "stability": run.stability.events() if run.stability is not None else [], "steps": steps}
-
-
-def contact_record(run: Run, output_seconds: float) -> dict:
-    """What contact costs: the contact forces' wall time per evaluation (search included,
-    timed on the last shape) and, of an explicit run, its share of the mean step."""
-    per_evaluation = run.tool_forces.seconds_per_evaluation(run.load_time, run.sim.state.fields.shape)
-    record = {"us_per_evaluation": 1e6 * per_evaluation}
-    if run.deck.solver.method == "explicit" and run.sim.state.steps:
-        record["share_of_step"] = per_evaluation * run.sim.state.steps / max(run.wall_time - output_seconds, 1e-300)
-    return record
-
-
-def valve_record(run: Run) -> dict:
-    """Each valve measure's last, smallest and largest value over the samples measured
-    (None for all three when none was)."""
-    record = {}
-    for column in VALVE_COLUMNS:
-        values = np.asarray(run.history[column])
-        measured = values[~np.isnan(values)]
-        record[column] = ({"final": float(measured[-1]), "min": float(measured.min()), "max": float(measured.max())}
-                          if len(measured) else dict.fromkeys(("final", "min", "max")))
-    return record
 
 
 def element_quality(run: Run) -> dict:

@@ -18,14 +18,12 @@ from functools import cached_property
 
 import numpy as np
 
-from ..curve_tables import factor
 from ..deck import Deck
-from ..deck.references import load_factor_columns
 from ..errors import NumericalError, OutputError, SceneTooLarge
-from ..loads import ToolForces, calibrate, measure_names, stable_step
+from ..loads import calibrate, needs_calibration, stable_step
 from ..mesh import Mesh
 from ..model import Model
-from .probes import Probe, probe_value, resolve_probes
+from .measures import Measure, resolve_measures
 from .relaxation import Relaxing
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
@@ -33,7 +31,6 @@ from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
 from .simulation import Simulation
 from .timestep import EstimateSchedule, massless_nodes
-from .valve import VALVE_COLUMNS, ValveMeasures, resolve_valve
 
 #: History samples over a run (fewer when the run has fewer steps).
 HISTORY_SAMPLES = 2000
@@ -65,7 +62,7 @@ class Run:
     mesh: Mesh
     model: Model
     sim: Simulation
-    probes: list[Probe]
+    measures: list[Measure] = field(default_factory=list)  # what the history samples, in column order
     dt: float = 0.0
     dt_critical: float = 0.0
     dt_history: list[tuple[float, float, float]] = field(default_factory=list)  # (t, dt_crit, dt)
@@ -83,9 +80,6 @@ class Run:
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
     stability: object | None = None  # a static solve's watch of its tangent's pivots (stability.StabilityWatch)
-    load_factors: dict[str, int] = field(default_factory=dict)  # history column -> curve index
-    tool_forces: ToolForces | None = None  # the contact tools' forces, history columns by their names
-    valve: ValveMeasures | None = None  # the valve's measures, history columns VALVE_COLUMNS
     relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
     unloading: object | None = None  # finding an imaged scene's unloaded shape (unloaded.Unloading)
     stepping: Stepping | None = None  # the time loop's place between step estimates, once it has begun
@@ -95,6 +89,10 @@ class Run:
         """The time the loads read their curves at: the clock, but for an arc-length path
         (:mod:`shellsim.solver.arc_length`) the load time its last step reached."""
         return self.newton[-1].load_time if self.newton else self.sim.state.t
+
+    def measure(self, name: str) -> Measure | None:
+        """The measure family of that ``NAME`` the run samples ('valve', ...); None: none."""
+        return next((measure for measure in self.measures if measure.NAME == name), None)
 
     @property
     def balance_error(self) -> float:
@@ -189,25 +187,19 @@ class Timed(Listener):
 
 
 def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
-    """A run ready to start: simulation built, probes and a valve's measures resolved, contact springs set from
-    the masses and the structure's critical step (:func:`shellsim.loads.calibrate`)."""
-    probes = resolve_probes(deck.output.probe, mesh, model)
-    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model, static=deck.solver.method == "static"), probes=probes,
+    """A run ready to start: simulation built, penalty springs set from the masses and the
+    structure's critical step (:func:`shellsim.loads.calibrate`), and the measures the
+    deck asks for placed on the scene (:mod:`.measures`)."""
+    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model, static=deck.solver.method == "static"),
               quality=ElementQuality(mesh))
-    run.load_factors = load_factor_columns(deck)
-    names = [contact.name for contact in deck.contact]
-    run.history = ({p.name: [] for p in probes} | {name: [] for name in run.load_factors}
-                   | {column: [] for column in measure_names(names)})
-    if names:
+    if needs_calibration(model):
         s = run.sim.state
         calibrate(model, s.mt, s.mr, run.sim.critical_time_step())
         run.sim.evaluate_forces()  # the springs act from the start
-        run.tool_forces = ToolForces(model, names)
+    run.measures = resolve_measures(deck, mesh, model)
+    run.history = {column: [] for measure in run.measures for column in measure.columns}
     if deck.solver.relaxation is not None:
         run.relaxing = Relaxing(run, deck.solver.relaxation.residual)
-    run.valve = resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)
-    if run.valve is not None:
-        run.history |= {column: [] for column in VALVE_COLUMNS}
     return run
 
 
@@ -228,17 +220,9 @@ def output_times(deck: Deck) -> np.ndarray:
 
 def _record(run: Run, listener: Listener) -> None:
     run.times.append(run.sim.state.t)
-    for p in run.probes:
-        run.history[p.name].append(probe_value(run.sim, p))
-    for name, index in run.load_factors.items():
-        run.history[name].append(factor(run.model.curves, index, run.load_time))
-    if run.tool_forces is not None:
-        for name, force in run.tool_forces(run.load_time, run.sim.state.fields.shape).items():
-            run.history[name].append(force)
-    if run.valve is not None:
-        due = run.valve.due(run.sim.state.t)
-        for name, value in (run.valve(run.sim) if due else dict.fromkeys(VALVE_COLUMNS, math.nan)).items():
-            run.history[name].append(value)
+    for measure in run.measures:
+        for column, value in zip(measure.columns, measure.sample(run), strict=True):
+            run.history[column].append(value)
     run.energies.append(run.sim.state.energy.copy())
     listener.on_sample(run)
 

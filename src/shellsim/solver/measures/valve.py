@@ -1,5 +1,6 @@
 """Valve measures: what a deck's ``[output.valve]`` reads from a running simulation, resolved
-once on the mesh and read at the history samples it asks for.
+once on the mesh and read at the history samples it asks for; a measure family
+(:mod:`shellsim.solver.measures`) measured at some samples only.
 
 The orifice is read on a raster of the plane across the valve's axis: the inside of the
 annulus (its nodes' ring seen along the axis) less the leaflets' shadow. A leaflet's shadow
@@ -17,12 +18,12 @@ import numpy as np
 from numba import njit
 from scipy.ndimage import distance_transform_edt
 
-from ..deck.schema import Valve as ValveTable
-from ..element.kinematics import fibre_point
-from ..element.shape import EDGES
-from ..loads import ToolForces
-from ..mesh import Mesh, node_areas
-from ..model import Model
+from ...deck.schema import Valve as ValveTable
+from ...element.kinematics import fibre_point
+from ...element.shape import EDGES
+from ...loads import ToolForces
+from ...mesh import Mesh, node_areas
+from ...model import Model
 
 #: The measures' history columns, each with what it measures (for units).
 VALVE_COLUMNS = ValveTable.COLUMNS
@@ -56,6 +57,26 @@ class ValveMeasures:
     every: float
     contact: ToolForces
     next_time: float = 0.0
+
+    NAME = "valve"
+    sparse = True
+    columns = list(VALVE_COLUMNS)
+
+    def sample(self, run) -> list[float]:
+        """The measures at a sample where they are due (:meth:`due`), NaN at the others."""
+        measured = self(run.sim) if self.due(run.sim.state.t) else dict.fromkeys(VALVE_COLUMNS, math.nan)
+        return list(measured.values())
+
+    def record(self, run, output_seconds: float) -> dict:
+        """Each measure's last, smallest and largest value over the samples measured
+        (None for all three when none was)."""
+        record = {}
+        for column in VALVE_COLUMNS:
+            values = np.asarray(run.history[column])
+            measured = values[~np.isnan(values)]
+            record[column] = ({"final": float(measured[-1]), "min": float(measured.min()),
+                               "max": float(measured.max())} if len(measured) else dict.fromkeys(("final", "min", "max")))
+        return record
 
     def due(self, t: float) -> bool:
         """Whether the sample at time t is measured (each ``every``, the first from t = 0),
@@ -181,10 +202,15 @@ def widest_opening(open_pixels: np.ndarray) -> float:
     return float(2.0 * distance_transform_edt(window).max())
 
 
+def resolve(deck, mesh: Mesh, model: Model) -> ValveMeasures | None:
+    """The deck's ``[output.valve]`` placed on the mesh (None without one)."""
+    return resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)
+
+
 def resolve_valve(table: ValveTable | None, mesh: Mesh, model: Model, end_time: float) -> ValveMeasures | None:
-    """The deck's ``[output.valve]`` placed on the mesh (None without one): the leaflets'
-    elements, the annulus nodes ordered by angle about the axis through their centre, and
-    a frame across the axis."""
+    """A ``[output.valve]`` table placed on the mesh of a run to ``end_time`` (None without
+    one): the leaflets' elements, the annulus nodes ordered by angle about the axis through
+    their centre, and a frame across the axis."""
     if table is None:
         return None
     axis = np.asarray(table.axis, dtype=float) / np.linalg.norm(table.axis)

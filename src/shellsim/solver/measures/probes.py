@@ -1,5 +1,6 @@
 """Probes: what a deck's ``[[output.probe]]`` reads from a running simulation, resolved
-once on the mesh and read at every history sample."""
+once on the mesh and read at every history sample; a measure family
+(:mod:`shellsim.solver.measures`) with a column per probe."""
 
 from __future__ import annotations
 
@@ -7,15 +8,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..deck.schema import AXIS_COMPONENTS, POINT_QUANTITIES, TENSOR_COMPONENTS, VECTOR_COMPONENTS
-from ..deck.schema import Probe as ProbeTable
-from ..element.kinematics import fibre_point
-from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
-from ..errors import MeshError
-from ..mesh import Mesh
-from ..mesh import FACES
-from ..model import Model
-
+from ...deck.schema import AXIS_COMPONENTS, POINT_QUANTITIES, TENSOR_COMPONENTS, VECTOR_COMPONENTS
+from ...deck.schema import Probe as ProbeTable
+from ...element.kinematics import fibre_point
+from ...element.sampling import nearest_integration_point, pressure_band, thickness_mean
+from ...errors import MeshError
+from ...mesh import FACES, Mesh
+from ...model import Model
 
 
 @dataclass
@@ -122,3 +121,26 @@ def probe_value(sim, probe: Probe) -> float:
     if probe.component == "magnitude":
         return float(np.linalg.norm(vector))
     return float(vector[VECTOR_COMPONENTS[probe.component]])
+
+
+class Probes:
+    """The probes' columns, each probe's value at every sample."""
+
+    NAME = "probes"
+    sparse = False
+
+    def __init__(self, probes: list[Probe]):
+        self.probes = probes
+        self.columns = [p.name for p in probes]
+
+    def sample(self, run) -> list[float]:
+        return [probe_value(run.sim, p) for p in self.probes]
+
+    def record(self, run, output_seconds: float) -> None:
+        """Probes have no summary entry of their own: references read their columns."""
+
+
+def resolve(deck, mesh: Mesh, model: Model) -> Probes | None:
+    """The deck's probes on the mesh (None without any)."""
+    probes = resolve_probes(deck.output.probe, mesh, model)
+    return Probes(probes) if probes else None

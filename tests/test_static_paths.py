@@ -251,7 +251,7 @@ def test_load_steps_grow_back_after_a_cut_even_where_every_step_forms_many_tange
         def commit(self, step):
             run.newton.append(step)
 
-    static._load_steps(run, Cutting(), Listener(), run.deck.solver.end_time)
+    static.load_steps(run, Cutting(), Listener(), run.deck.solver.end_time)
     first = run.deck.solver.end_time / 10
     assert run.sim.state.t == pytest.approx(run.deck.solver.end_time)
     assert tried[1] == pytest.approx(first * static.CUT)

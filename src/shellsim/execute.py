@@ -64,7 +64,7 @@ def solve(run: Run, listener: Listener | None = None) -> Run:
     static preload; a run restored from a checkpoint goes on in time."""
     from .solver.preload import preload_then_integrate
     from .solver.run import integrate
-    from .solver.static import solve_static
+    from .solver.static_solve import solve_static
 
     solver = run.deck.solver
     method = (solve_static if solver.method == "static" else

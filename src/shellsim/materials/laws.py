@@ -23,9 +23,12 @@ from numba import types
 from ..compiled_call import held_by_address
 from ..table_types import tag_of
 from . import guccione, hgo, lee_sacks, mooney_rivlin, st_venant_kirchhoff
+from .linear import LinearElastic
 
 #: The laws, in the order of their codes.
 LAWS = (mooney_rivlin, guccione, st_venant_kirchhoff, hgo, lee_sacks)
+# the small-strain model's message for a nu out of range names the incompressible models
+LinearElastic.INCOMPRESSIBLE_MODELS = tuple(tag_of(cls)[1] for law in LAWS if law.INCOMPRESSIBLE for cls in law.MODELS)
 
 
 def law_of(model: str):

@@ -14,7 +14,7 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import field_validator
 
-from ..table_types import Positive, Real, Section, tag_of
+from ..table_types import Positive, Real, Section
 
 #: Transverse shear correction factor on the 13 and 23 shear moduli (Reissner-Mindlin,
 #: the value Hughes-Liu shells and LS-DYNA's SHRF default use). The thesis does not state
@@ -31,16 +31,16 @@ class LinearElastic(Section):
     density: Positive
     HYPERELASTIC: ClassVar[bool] = False
     ANISOTROPIC: ClassVar[bool] = False
+    #: The models incompressible tissue takes instead, named in the message of a nu out of
+    #: range: the law registry above this module fills it in (:mod:`.laws`).
+    INCOMPRESSIBLE_MODELS: ClassVar[tuple[str, ...]] = ()
 
     @field_validator("nu")
     @classmethod
     def _compressible(cls, nu: float) -> float:
         if not -1.0 < nu < 0.5:
-            from .laws import LAWS  # the registry imports this module's neighbours
-
-            incompressible = [tag_of(cls)[1] for law in LAWS if law.INCOMPRESSIBLE for cls in law.MODELS]
             raise ValueError(f"a compressible model needs -1 < nu < 0.5, got {nu}; for incompressible "
-                             f"tissue use model = {' | '.join(repr(m) for m in incompressible)}")
+                             f"tissue use model = {' | '.join(repr(m) for m in cls.INCOMPRESSIBLE_MODELS)}")
         return nu
 
 

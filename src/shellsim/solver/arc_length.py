@@ -38,7 +38,7 @@ import numpy as np
 from ..compiled_call import TypedCall
 from ..errors import NumericalError
 from ..loads import external_forces
-from .run import Listener, Run, _frame, _record, output_times
+from .run import Listener, Run, output_times, take_frame, take_sample
 from .equilibrium import Converged
 from .static import ARC_ADVICE, CUT, NewtonSolver, NewtonStep, NotConverged, not_converged
 
@@ -305,7 +305,7 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
         if held is not None:
             if arc.forward < 0.0 and np.isinf(held):
                 newton.stability.unloaded(before, arc.load_time, end)
-                _frame(run, listener)
+                take_frame(run, listener)
                 return
             step = arc.hold(held, to_mark)
         else:
@@ -320,9 +320,9 @@ def follow_path(run: Run, newton: NewtonSolver, listener: Listener) -> None:
                 length = min(length, LONGEST * first, length * MOST_TURN / max(arc.turn, 1e-300))
         sim.state.t = step.t
         newton.commit(step)
-        _record(run, listener)
+        take_sample(run, listener)
         if np.any((marks > before) & (marks <= sim.state.t + 1e-12 * end)):
-            _frame(run, listener)
+            take_frame(run, listener)
         stalled = stalled + 1 if sim.state.t - before < STALL * end else 0
         if stalled >= STALLED_STEPS:
             raise NumericalError(f"arc length made no progress: {stalled} steps in a row moved the clock by less "

@@ -7,13 +7,13 @@ artery at diastolic pressure before the heartbeat) in seconds instead of a dampe
 from __future__ import annotations
 
 from .run import Listener, Run, integrate
-from .static import solve_static
+from .static_solve import solve_static
 
 
 def preload_then_integrate(run: Run, listener: Listener | None = None) -> Run:
     """Solve ``run`` statically to ``solver.preload``, then integrate it from rest to the
     end time; one history and one series of frames over both. Raises as
-    :func:`shellsim.solver.static.solve_static` in the first phase and as
+    :func:`shellsim.solver.static_solve.solve_static` in the first phase and as
     :func:`shellsim.solver.run.integrate` in the second."""
     listener = listener or Listener()
     solve_static(run, listener, until=run.deck.solver.preload)

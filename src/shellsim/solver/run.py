@@ -218,7 +218,9 @@ def output_times(deck: Deck) -> np.ndarray:
     return times[times > 0.0]
 
 
-def _record(run: Run, listener: Listener) -> None:
+def take_sample(run: Run, listener: Listener) -> None:
+    """A history sample now: the time, every measure's columns, the energies; then
+    ``listener.on_sample``."""
     run.times.append(run.sim.state.t)
     for measure in run.measures:
         for column, value in zip(measure.columns, measure.sample(run), strict=True):
@@ -239,7 +241,9 @@ def interrupt_deferred() -> Iterator[None]:
         signal.raise_signal(number)
 
 
-def _frame(run: Run, listener: Listener) -> None:
+def take_frame(run: Run, listener: Listener) -> None:
+    """A frame now (``listener.on_frame``), counted once written: a stop signal waits
+    for it."""
     with interrupt_deferred():
         listener.on_frame(run)
         run.frame_times.append(run.sim.state.t)
@@ -321,7 +325,7 @@ def _breaking_frame(run: Run, listener: Listener) -> None:
     if run.frame_times and run.frame_times[-1] == s.t or not np.isfinite(s.x).all():
         return
     with suppress(OutputError):  # the breakdown is the news; the summary still records it
-        _frame(run, listener)
+        take_frame(run, listener)
         run.breaking_frame = s.t
 
 
@@ -352,8 +356,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
             refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
             run.startup["first_dt_s"] = time.perf_counter() - start
             if not run.times:  # else it continues a preload, whose last state is recorded
-                _record(run, listener)
-                _frame(run, listener)
+                take_sample(run, listener)
+                take_frame(run, listener)
             schedule = EstimateSchedule(solver.dt_safety_factor, solver.dt_update_every)
             run.stepping = Stepping(schedule, schedule.after_estimate(sim.state.steps, run.dt_critical))
         stepping = run.stepping
@@ -373,10 +377,10 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                         stepping.interval = stepping.schedule.after_estimate(sim.state.steps, run.dt_critical)
                         stepping.since_update = 0
                         break  # re-plan the steps with the new dt
-                _record(run, listener)
+                take_sample(run, listener)
                 _check_stability(run)
                 at_rest = run.relaxing is not None and run.relaxing.at_rest(sim)
-            _frame(run, listener)
+            take_frame(run, listener)
             if at_rest:
                 break
     if run.relaxing is not None and not at_rest:  # the answer asked for is the state of rest

@@ -30,7 +30,7 @@ from ..errors import NumericalError, id_list, place
 from ..loads import passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
-from .run import Listener, Run, _frame, _record, ending, output_times
+from .run import Listener, Run, output_times, take_frame, take_sample
 from .sparse_lu import SymmetricPatternLU
 from .stability import StabilityWatch
 from .static_work import StaticWork
@@ -325,34 +325,7 @@ class NewtonSolver:
         self.work.add_step()
 
 
-def solve_static(run: Run, listener: Listener | None = None, until: float | None = None) -> Run:
-    """Solve the scene statically from t = 0 to the deck's end time (or ``until``, a
-    preload's end), by load steps or along the path (``solver.static.control``),
-    sampling the history at every converged step and writing frames at the output times.
-
-    Raises NumericalError (status 'not converged') naming where in the load, the residual
-    and the worst place when a step cannot be solved even cut to ``min_increment``; the
-    samples and frames until then are kept. KeyboardInterrupt passes through with
-    ``run.status = 'interrupted'``.
-    """
-    from .arc_length import follow_path
-
-    listener = listener or Listener()
-    with ending(run, listener, "not converged"):  # a breaking frame is the last converged state
-        newton = NewtonSolver(run)
-        run.startup["first_dt_s"] = 0.0
-        _record(run, listener)
-        _frame(run, listener)
-        if run.deck.solver.static.control == "arc_length":
-            follow_path(run, newton, listener)
-        else:
-            _load_steps(run, newton, listener, until or run.deck.solver.end_time)
-        if newton.settings.check_stability:
-            newton.observe()
-    return run
-
-
-def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) -> None:
+def load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) -> None:
     """Load control to ``end``: steps that land on every output time before it."""
     sim = run.sim
     largest = end / newton.settings.increments
@@ -369,11 +342,11 @@ def _load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) 
             if newton.settings.check_stability and observed + largest * (1.0 - 1e-9) <= step.t < end * (1.0 - 1e-12):
                 newton.observe()  # the end's is the run's last
                 observed = step.t
-            _record(run, listener)
+            take_sample(run, listener)
             uncut = uncut + 1 if step.cutbacks == 0 else 0
             if step.cutbacks == 0 and (step.tangents <= GROWTH_TANGENTS or uncut >= 2):
                 length, uncut = min(length * GROW, largest), 0
-        _frame(run, listener)
+        take_frame(run, listener)
 
 
 #: What may get a load-controlled static solve past where it stopped.

@@ -38,7 +38,7 @@ def unloaded_mesh(scene: Deck, imaged: Mesh, announce: Callable[[str], None]) ->
 
     from ..model import build_model
     from .run import prepare
-    from .static import solve_static
+    from .static_solve import solve_static
 
     settings, start = scene.solver.imaged, time.perf_counter()
     size = float(np.ptp(imaged.x, axis=0).max())

@@ -72,6 +72,23 @@ class Mesh:
         return len(self.conn)
 
 
+@dataclass(frozen=True)
+class ImportedMesh:
+    """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and
+    thickness (n,), per-element vectors (ne, 3) and scalar fields per node (n,) and per
+    element (ne,) by name; lines (L, 2) its cable elements (their nodes may be on no shell)."""
+
+    x: np.ndarray
+    conn: np.ndarray
+    sets: dict[str, NamedSet]
+    director: np.ndarray | None
+    thickness: np.ndarray | None
+    cell_vectors: dict[str, np.ndarray]
+    point_fields: dict[str, np.ndarray]
+    cell_fields: dict[str, np.ndarray]
+    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
+
+
 def tangents(x: np.ndarray, conn: np.ndarray, rs: np.ndarray) -> np.ndarray:
     """Surface tangents g_r = dx/dr, g_s = dx/ds at natural points ``rs``.
 

@@ -1,6 +1,6 @@
 """Point kinematics of an element group: geometry, strains, and the stress's way back to
 nodal forces (thesis 3.3-3.6), every array with the group's lanes last (G, see
-:mod:`shellsim.element.lanes`).
+:mod:`shellsim.lanes`).
 
 Kinematics (thesis Eq 3.3): y(r, s, t) = sum_a N_a (x_a + t h_a/2 d_a), with mid-surface
 nodes x_a, unit directors d_a and fibre lengths h_a. A director moves by

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import MeshError
-from ..geometry.importing import ImportedMesh
+from ..mesh import ImportedMesh
 
 
 @dataclass(frozen=True)

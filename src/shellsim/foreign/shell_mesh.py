@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SHOWN_IDS, MeshError
-from ..geometry.importing import ImportedMesh
+from ..mesh import ImportedMesh
 from ..mesh import NamedSet, averaged_directors, edges_within, element_normals, orient_consistently
 from .quad_upgrade import split, upgrade
 

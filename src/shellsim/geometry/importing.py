@@ -15,13 +15,12 @@ of three components on the quad9 cells (e.g. fibre directions) is kept by name.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import MeshError, id_list
-from ..mesh import NamedSet, edges_within
+from ..mesh import ImportedMesh, NamedSet, edges_within
 from ..mesh_reading import read_meshio
 from .file_checks import (
     GMSH_QUAD9, collapsed_problem, missing_nodes_problem, point_data_problems, repeated_node_problem,
@@ -37,23 +36,6 @@ _DIMENSION = {"quad9": 2, "line3": 1, "line": 1, "vertex": 0}
 #: Surface and volume cells other than quad9: a file holding them is not a quad9 shell mesh.
 _NOT_QUAD9 = {"triangle", "triangle6", "triangle7", "quad", "quad8", "polygon", "tetra", "tetra10", "hexahedron",
               "hexahedron20", "hexahedron27", "wedge", "pyramid"}
-
-
-@dataclass(frozen=True)
-class ImportedMesh:
-    """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and
-    thickness (n,), per-element vectors (ne, 3) and scalar fields per node (n,) and per
-    element (ne,) by name; lines (L, 2) its cable elements (their nodes may be on no shell)."""
-
-    x: np.ndarray
-    conn: np.ndarray
-    sets: dict[str, NamedSet]
-    director: np.ndarray | None
-    thickness: np.ndarray | None
-    cell_vectors: dict[str, np.ndarray]
-    point_fields: dict[str, np.ndarray]
-    cell_fields: dict[str, np.ndarray]
-    lines: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
 
 
 def read_mesh(path: Path) -> ImportedMesh:

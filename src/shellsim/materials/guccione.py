@@ -10,7 +10,7 @@ along the fibre, b_12 = b_13 = C4 for the fibre shears and C3 for the rest
     (CC^w : dE)_ij = C1 e^Q b_ij (dE_ij + E_ij dQ),  dQ = 2 sum_kl b_kl E_kl dE_kl.
 
 Parameters (C1 [stress], C2, C3, C4 [-]). Arrays (3, 3, G) carry one strain per lane of an
-element group (:mod:`shellsim.element.lanes`).
+element group (:mod:`shellsim.lanes`).
 """
 
 from __future__ import annotations

@@ -29,7 +29,7 @@ chi' = k chi (1 - chi), chi'' = k chi' (1 - 2 chi).
 
 Parameters (mu, k1 [stress], k2, kappa [-], cos beta, sin beta, k [-], 0 for the sharp
 exclusion). Arrays (3, 3, G) carry one strain per lane of an element group
-(:mod:`shellsim.element.lanes`).
+(:mod:`shellsim.lanes`).
 """
 
 from __future__ import annotations

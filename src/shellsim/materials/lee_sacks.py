@@ -14,7 +14,7 @@ with e1 = exp(4 c2 tr(E)^2), e4 = exp(4 c3 (a.E a)^2),
               + 4 c1 (1 - delta) c3 e4 (1 + 8 c3 (a.E a)^2) (A : dE) A.
 
 Parameters (c0, c1 [stress], c2, c3, delta [-], cos beta, sin beta). Arrays (3, 3, G) carry
-one strain per lane of an element group (:mod:`shellsim.element.lanes`).
+one strain per lane of an element group (:mod:`shellsim.lanes`).
 """
 
 from __future__ import annotations

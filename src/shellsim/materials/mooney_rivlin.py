@@ -12,7 +12,7 @@ and its derivative in a direction dE (dC = 2 dE, dI1 = 2 tr dE)
 
 Parameters (C1, C2) [stress]; the incompressibility and zero normal stress are
 :mod:`shellsim.materials.zero_normal_stress`'s. Arrays (3, 3, G) carry one strain per lane
-of an element group (:mod:`shellsim.element.lanes`).
+of an element group (:mod:`shellsim.lanes`).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ with k_ij = kappa, the transverse shear factor of the small-strain law, for the 
 E_33 = -lambda (E_11 + E_22) / (lambda + 2 mu) (:mod:`shellsim.materials.zero_normal_stress`).
 
 Parameters (lambda, mu [stress], kappa [-]). Arrays (3, 3, G) carry one strain per lane
-of an element group (:mod:`shellsim.element.lanes`).
+of an element group (:mod:`shellsim.lanes`).
 """
 
 from __future__ import annotations

@@ -153,7 +153,7 @@ def snapshot(run: Run) -> dict:
     return {"format": FORMAT, "version": __version__, "scene": fingerprint(run),
             "t": state.t, "dt_prev": state.dt_prev, "steps": state.steps,
             "arrays": [array.copy() for array in _carried(run)],
-            "eigenvector": sim._eigenvector, "fresh": sim._fresh.bit_generator.state, "mass_factor": sim.mass_factor,
+            "eigenvector": sim.eigenvector, "fresh": sim.fresh.bit_generator.state, "mass_factor": sim.mass_factor,
             "record": {name: getattr(run, name) for name in RECORD}, "frame_times": [*run.frame_times, state.t],
             "watches": {name: _numbers(watch) for name, watch in _watches(run).items()}}
 
@@ -236,7 +236,7 @@ def _check_fits(run: Run, saved: dict) -> None:
     wrong = [name for name in RECORD if not _conforms(record[name], SPECS[name])]
     if wrong or record["history"].keys() != run.history.keys():
         raise ValueError(f"its record's {', '.join(wrong) or 'history columns'} are not a run's")
-    type(run.sim._fresh.bit_generator)().state = saved["fresh"]  # a generator of the kind takes it
+    type(run.sim.fresh.bit_generator)().state = saved["fresh"]  # a generator of the kind takes it
 
 
 def restore(run: Run, saved: dict) -> None:
@@ -257,8 +257,8 @@ def restore(run: Run, saved: dict) -> None:
     for target, values in zip(_carried(run), saved["arrays"]):
         target[...] = values
     state.t, state.dt_prev, state.steps = float(saved["t"]), float(saved["dt_prev"]), saved["steps"]
-    sim._eigenvector, sim.mass_factor = saved["eigenvector"], float(saved["mass_factor"])
-    sim._fresh.bit_generator.state = saved["fresh"]
+    sim.eigenvector, sim.mass_factor = saved["eigenvector"], float(saved["mass_factor"])
+    sim.fresh.bit_generator.state = saved["fresh"]
     for name, value in saved["record"].items():
         setattr(run, name, value)
     run.frame_times = [float(t) for t in saved["frame_times"]]

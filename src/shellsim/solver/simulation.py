@@ -79,8 +79,10 @@ class Simulation:
                                  applied_forces=TypedCall(explicit.applied_forces))
         #: the internal forces called from Python, where no time loop is compiled
         self.elements = ElementLoop(self.response) if static else None
-        self._eigenvector: np.ndarray | None = None
-        self._fresh = np.random.default_rng(0)  # the random half of each later estimate's start (reproducible)
+        #: the critical-step estimator's state, which a checkpoint carries: the last estimate's
+        #: eigenvector (5n,), and the generator of the random half of each later estimate's start
+        self.eigenvector: np.ndarray | None = None
+        self.fresh = np.random.default_rng(0)
         self.threads = ThreadChooser(limit_to_usable_cpus())
         self.mass_factor = 1.0  # every mass scaled by it (mass scaling)
         with response.alongside():
@@ -124,7 +126,7 @@ class Simulation:
     def critical_time_step(self, on_product: Callable[[int], None] | None = None) -> float:
         """dt_critical = 2 / omega_max at the current state (Lanczos, from the last eigenvector after the first);
         ``on_product(count)`` hears of each stiffness product."""
-        dt, self._eigenvector = critical_time_step(self, self._eigenvector, on_product, self._fresh)
+        dt, self.eigenvector = critical_time_step(self, self.eigenvector, on_product, self.fresh)
         return dt
 
     def evaluate_forces(self) -> None:

@@ -49,7 +49,9 @@ and, when it has kernels of its own,
   ``extend_mesh(table, mesh)``, the mesh with its nodes and sets added (before the model
   is built), ``add_masses(bundle, mt, mr)``, its masses added to the shell's (n,), and
   compiled ``critical_step(shape, bundle)``, the step its elements allow on their own.
-Adding a kind is writing its module and adding it to :data:`KINDS`.
+Adding a kind is writing its module and adding it to :data:`KINDS`; which of these
+hooks its role (a load, a contact, a cable) must and may have is :mod:`.contract`'s, checked
+as the registry imports it.
 """
 
 from __future__ import annotations
@@ -67,17 +69,19 @@ from ..element.frames import to_rotational
 from ..errors import MeshError
 from ..mesh import node_areas
 from . import cable, edge_pressure, mapped_pressure, nodal, pressure, rigid_tool, shell_contact
+from .contract import check_kind
 
 #: The kinds, in the order their forces are added.
 KINDS = (nodal, pressure, edge_pressure, mapped_pressure, rigid_tool, shell_contact, cable)
+#: Each kind's role, its hooks checked against the role's contract (:mod:`.contract`).
+ROLE = {kind: check_kind(kind) for kind in KINDS}
 
 #: The kinds with kernels of their own: the fields of :data:`Loads`.
 CARRIERS = tuple(kind for kind in KINDS if hasattr(kind, "Bundle"))
 
 #: Every ``[[load]]``, ``[[contact]]`` and ``[[cable]]`` deck table, and the kind that builds each.
-TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "load")
-CONTACT_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "contact")
-CABLE_TABLES = tuple(table for kind in KINDS for table in kind.TABLES if table.DECK_KEY == "cable")
+TABLES, CONTACT_TABLES, CABLE_TABLES = (tuple(table for kind in KINDS if ROLE[kind] == role for table in kind.TABLES)
+                                        for role in ("load", "contact", "cable"))
 #: The deck's lists of load tables, by their keys.
 DECK_KEYS = ("load", "contact", "cable")
 _KIND_OF = {table: kind for kind in KINDS for table in kind.TABLES}

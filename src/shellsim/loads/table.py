@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from typing import Annotated, ClassVar
 
-from pydantic import Field
+from pydantic import Field, field_validator
 
-from ..table_types import Name, NonNegative, Positive, Section
+from ..table_types import Name, NonNegative, Positive, Section, tag_of
 
 #: The largest Coulomb coefficient taken: wet tissue on tissue or a device slides at 0.01-0.5,
 #: dry rubber on rubber at about 1-2; more is a typing mistake, not a surface.
@@ -56,6 +56,16 @@ class ContactTable(LoadTable):
     DECK_KEY: ClassVar[str] = "contact"
     SET_KINDS: ClassVar[tuple[str, ...]] = ("surface",)
     FEATURES: ClassVar[tuple[str, ...]] = ("contact",)
+    #: Whether its kind slides with friction (has ``add_friction``; the registry checks):
+    #: where it does not, a friction given is refused rather than ignored.
+    FRICTION: ClassVar[bool] = True
+
+    @field_validator("friction")
+    @classmethod
+    def _slides(cls, friction: float) -> float:
+        if friction and not cls.FRICTION:
+            raise ValueError(f"the {tag_of(cls)[1]!r} contact has no friction; leave friction out")
+        return friction
 
     @property
     def friction_summary(self) -> str:

@@ -89,16 +89,29 @@ def applied_forces(t, model, fields, space):
 
 
 @njit(cache=True)
-def half_work(f, fr, dx, w, step):
-    """Half the work of the forces f (n, 3), fr (n, 2) over the translations dx (n, 3)
-    and the rotations step * w (n, 2): one half of the trapezoidal rule."""
-    work = 0.0
+def half_work(f, fr, dx, w, step, work=0.0):
+    """``work`` plus half the work of the forces f (n, 3), fr (n, 2) over the translations
+    dx (n, 3) and the rotations step * w (n, 2): one half of the trapezoidal rule, added
+    node by node onto ``work`` (so a step's sum is the same whichever way it is split)."""
     for node in range(f.shape[0]):
         for i in range(3):
             work += 0.5 * f[node, i] * dx[node, i]
         for j in range(2):
             work += 0.5 * fr[node, j] * step * w[node, j]
     return work
+
+
+@njit(cache=True)
+def damping_work(damping, mt, mr, v, w, dx, step):
+    """The work of mass-proportional damping ``damping`` [1/s] over a step: c m v . dx on
+    the translations and c m_r w . w step on the rotations, masses mt, mr (n,)."""
+    damped = 0.0
+    for node in range(v.shape[0]):
+        for i in range(3):
+            damped += damping * mt[node] * v[node, i] * dx[node, i]
+        for j in range(2):
+            damped += damping * mr[node] * w[node, j] * w[node, j] * step
+    return damped
 
 
 @njit(cache=True)
@@ -123,6 +136,51 @@ def kinetic_damping(v, w, mt, mr, kinetic, work, relax):
     relax[1] += 1.0
     work[DAMPED] += kinetic
     return 0.0
+
+
+@njit(cache=True)
+def update_velocities(fields, projector, rot_free, c, dt_avg):
+    """The velocities v (n, 3), w (n, 2) of ``fields`` a step of average length ``dt_avg``
+    on, from their forces, damped by c = damping * dt_avg and projected on what the
+    supports allow (projector (n, 3, 3), rot_free (n, 2)), in place. Returns the kinetic
+    energy 1/2 v(n-1/2) M v(n+1/2) that central differences conserve."""
+    v, w, mt, mr = fields.v, fields.w, fields.mt, fields.mr
+    f_int, fr_int, f_ext, fr_ext = fields.f_int, fields.fr_int, fields.f_ext, fields.fr_ext
+    a = np.empty(3)
+    kinetic = 0.0
+    for node in range(v.shape[0]):
+        for i in range(3):
+            a[i] = ((1.0 - 0.5 * c) * v[node, i] + dt_avg * (f_ext[node, i] - f_int[node, i]) / mt[node]) / (1.0 + 0.5 * c)
+        for i in range(3):
+            v_new = projector[node, i, 0] * a[0] + projector[node, i, 1] * a[1] + projector[node, i, 2] * a[2]
+            kinetic += 0.5 * mt[node] * v[node, i] * v_new
+            v[node, i] = v_new
+        for j in range(2):
+            w_new = rot_free[node, j] * ((1.0 - 0.5 * c) * w[node, j]
+                                         + dt_avg * (fr_ext[node, j] - fr_int[node, j]) / mr[node]) / (1.0 + 0.5 * c)
+            kinetic += 0.5 * mr[node] * w[node, j] * w_new
+            w[node, j] = w_new
+    return kinetic
+
+
+@njit(cache=True)
+def move(fields, space, step):
+    """The shape of ``fields`` moved by its velocities over ``step``, in place: positions,
+    directors (rotated, their fibre frames with them) and rotation angles; the moves dx and
+    director changes dd (n, 3) into ``space``."""
+    x, d, e1, v, w, theta = fields.shape.x, fields.shape.d, fields.shape.e1, fields.v, fields.w, fields.theta
+    dx, dd = space.dx, space.dd
+    d_old = np.empty(3)
+    for node in range(x.shape[0]):
+        for i in range(3):
+            dx[node, i] = step * v[node, i]
+            x[node, i] += dx[node, i]
+        copy_into(d[node], d_old)
+        rotate_director(d[node], e1[node], step * w[node, 0], step * w[node, 1])
+        for i in range(3):
+            dd[node, i] = d[node, i] - d_old[i]
+        theta[node, 0] += step * w[node, 0]
+        theta[node, 1] += step * w[node, 1]
 
 
 @njit(cache=True)
@@ -152,17 +210,13 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
     an explicit run's forces from Python come from the time loop it compiles anyway, not
     from an element loop and loads compiled once more (5-10 s of a first run).
     """
-    x, d, e1 = fields.shape.x, fields.shape.d, fields.shape.e1
-    v, w, theta, mt, mr = fields.v, fields.w, fields.theta, fields.mt, fields.mr
+    x, v, w, mt, mr = fields.shape.x, fields.v, fields.w, fields.mt, fields.mr
     f_int, fr_int, f_ext, fr_ext = fields.f_int, fields.fr_int, fields.f_ext, fields.fr_ext
     work, energy = fields.work, fields.energy
     projector, rot_free, prescribed = model.constraints.projector, model.constraints.rot_free, model.constraints.prescribed
     prescribed_velocity = fields.prescribed_velocity
     damping = model.damping
-    dx, dd = space.dx, space.dd
-    n = x.shape[0]
-    d_old = np.empty(3)
-    a = np.empty(3)
+    dx = space.dx
     steps = 0
     step = work_ext = work_int = work_fr = kinetic = 0.0  # set by each step's motion, read after its forces
     moved = False  # a step has moved the shape since the forces were evaluated
@@ -176,16 +230,10 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
         if moved:
             if space.friction:
                 work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
-            damped = 0.0
-            for node in range(n):
-                for i in range(3):
-                    work_ext += 0.5 * f_ext[node, i] * dx[node, i]
-                    work_int += 0.5 * f_int[node, i] * dx[node, i]
-                    damped += damping * mt[node] * v[node, i] * dx[node, i]
-                for j in range(2):
-                    work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
-                    work_int += 0.5 * fr_int[node, j] * step * w[node, j]
-                    damped += damping * mr[node] * w[node, j] * w[node, j] * step
+            # the trapezoidal works' second half, with the forces at the step's end
+            work_ext = half_work(f_ext, fr_ext, dx, w, step, work_ext)
+            work_int = half_work(f_int, fr_int, dx, w, step, work_int)
+            damped = damping_work(damping, mt, mr, v, w, dx, step)
             work[INTERNAL] += work_int
             work[EXTERNAL] += work_ext - work_fr  # the friction forces are among the external ones
             work[DAMPED] += damped
@@ -204,20 +252,7 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
         work_ext = 0.0
         work_int = 0.0
         work_fr = 0.0
-        kinetic = 0.0
-        for node in range(n):
-            # translations: velocity update, constraint projection
-            for i in range(3):
-                a[i] = ((1.0 - 0.5 * c) * v[node, i] + dt_avg * (f_ext[node, i] - f_int[node, i]) / mt[node]) / (1.0 + 0.5 * c)
-            for i in range(3):
-                v_new = projector[node, i, 0] * a[0] + projector[node, i, 1] * a[1] + projector[node, i, 2] * a[2]
-                kinetic += 0.5 * mt[node] * v[node, i] * v_new
-                v[node, i] = v_new
-            for j in range(2):
-                w_new = rot_free[node, j] * ((1.0 - 0.5 * c) * w[node, j]
-                                             + dt_avg * (fr_ext[node, j] - fr_int[node, j]) / mr[node]) / (1.0 + 0.5 * c)
-                kinetic += 0.5 * mr[node] * w[node, j] * w_new
-                w[node, j] = w_new
+        kinetic = update_velocities(fields, projector, rot_free, c, dt_avg)
         if model.kinetic_damping:
             kinetic = kinetic_damping(v, w, mt, mr, kinetic, work, space.relax)
         for p in range(prescribed.nodes.shape[0]):
@@ -236,24 +271,10 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
         energy[EXTERNAL] = work[EXTERNAL]
         energy[DAMPED] = work[DAMPED]
         energy[FRICTION] = work[FRICTION]
-        for node in range(n):
-            for i in range(3):
-                dx[node, i] = step * v[node, i]
-                x[node, i] += dx[node, i]
-            copy_into(d[node], d_old)
-            rotate_director(d[node], e1[node], step * w[node, 0], step * w[node, 1])
-            for i in range(3):
-                dd[node, i] = d[node, i] - d_old[i]
-            theta[node, 0] += step * w[node, 0]
-            theta[node, 1] += step * w[node, 1]
+        move(fields, space, step)
         # trapezoidal work: first half with the forces at t, second with those at t + step
-        for node in range(n):
-            for i in range(3):
-                work_ext += 0.5 * f_ext[node, i] * dx[node, i]
-                work_int += 0.5 * f_int[node, i] * dx[node, i]
-            for j in range(2):
-                work_ext += 0.5 * fr_ext[node, j] * step * w[node, j]
-                work_int += 0.5 * fr_int[node, j] * step * w[node, j]
+        work_ext = half_work(f_ext, fr_ext, dx, w, step, work_ext)
+        work_int = half_work(f_int, fr_int, dx, w, step, work_int)
         if space.friction:
             work_fr += half_work(space.f_fr, space.fr_fr, dx, w, step)
         t += step

@@ -56,7 +56,7 @@ class Stepping:
 
 @dataclass
 class Run:
-    """A scene being run: the simulation, its time step record and probe histories."""
+    """A scene being run: the simulation, its time step record and measured histories."""
 
     deck: Deck
     mesh: Mesh
@@ -91,7 +91,7 @@ class Run:
         return self.newton[-1].load_time if self.newton else self.sim.state.t
 
     def measure(self, name: str) -> Measure | None:
-        """The measure family of that ``NAME`` the run samples ('valve', ...); None: none."""
+        """The measure family of that ``NAME`` the run samples (its family's NAME); None: none."""
         return next((measure for measure in self.measures if measure.NAME == name), None)
 
     @property

@@ -91,7 +91,7 @@ class Run:
         return self.newton[-1].load_time if self.newton else self.sim.state.t
 
     def measure(self, name: str) -> Measure | None:
-        """The measure family of that ``NAME`` the run samples (its family's NAME); None: none."""
+        """The measure of the family called ``name`` (its NAME) that the run samples; None: none."""
         return next((measure for measure in self.measures if measure.NAME == name), None)
 
     @property

@@ -11,7 +11,7 @@ from shellsim.deck import load_deck, parse_deck
 from shellsim.mesh import layer_geometry
 from shellsim.output.encoding import symmetric_tensors
 from shellsim.output.fields import frame_fields, output_mesh
-from shellsim.solver.measures.probes import probe_value, resolve_probes
+from shellsim.measures.probes import probe_value, resolve_probes
 
 from .conftest import ROOT, deck_text, prepared, problems_of, run_deck
 

@@ -21,6 +21,7 @@ FLOORS = [
     {"element"},
     {"mesh"},
     {"loads"},
+    {"measures"},
     {"deck"},
     {"foreign"},
     {"geometry"},

@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 
 from shellsim.deck import parse_deck
-from shellsim.deck.schema import Valve
 from shellsim.mesh import NamedSet
-from shellsim.solver.measures.valve import fill_triangles, largest_principal, resolve_valve
+from shellsim.measures.valve import Valve, fill_triangles, largest_principal, resolve_valve
 
 from .conftest import PLATE_THICKNESS, deck_text, pressed_plates, prepared, problems_of, run_deck
 

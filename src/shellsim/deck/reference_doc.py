@@ -17,6 +17,7 @@ from .material import MATERIALS
 from ..loads import CABLE_TABLES, CONTACT_TABLES
 from ..loads.cable_laws import CABLE_LAWS
 from ..loads import TABLES as LOAD_TABLES
+from ..measures import FAMILIES
 from ..table_types import tag_of
 
 INTRO = """# Deck reference
@@ -87,9 +88,11 @@ def deck_reference() -> str:
     lines += _table(schema.Solver, "## [solver]")
     lines += _table(schema.Static, "### [solver.static]")
     lines += _table(schema.Output, "## [output]")
-    lines += _table(schema.Probe, "## [[output.probe]]")
     lines += _table(schema.Render, "## [[output.render]]")
-    lines += _table(schema.Valve, "## [output.valve]")
+    for family in FAMILIES:
+        if hasattr(family, "TABLE"):
+            many = family.OUTPUT_FIELD[1] == []
+            lines += _table(family.TABLE, f"## [[output.{family.OUTPUT_KEY}]]" if many else f"## [output.{family.OUTPUT_KEY}]")
     lines += _table(schema.Reference, "## [reference] (one) or [[reference]] (several)")
     return "\n".join(lines).rstrip() + "\n"
 

@@ -10,7 +10,8 @@ from __future__ import annotations
 import difflib
 
 from ..loads import DECK_KEYS
-from .columns import column_clashes, measured_columns
+from ..measures import measured_columns
+from .columns import column_clashes
 from .schema import Deck
 
 

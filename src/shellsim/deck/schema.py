@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import json
 from itertools import combinations
-from typing import Annotated, ClassVar, Literal, Union, get_args
+from typing import Annotated, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BeforeValidator, Field, field_validator, model_validator
+from pydantic import BeforeValidator, Field, create_model, field_validator, model_validator
 
 from .curves import Curve
 from .geometry import BUILDERS, Geometry, proportion_problems
@@ -20,7 +20,8 @@ from .material import MATERIALS, Material
 from ..materials.axes import CentrelineAxes, CylindricalAxes
 from ..loads import CABLE_TABLES, CONTACT_TABLES
 from ..loads import TABLES as LOAD_TABLES
-from ..table_types import Count, Line, Name, NonNegative, Positive, Real, Section, Text, Vec3, need_directions, repeated
+from ..measures import OUTPUT_FIELDS
+from ..table_types import Count, Line, Name, NonNegative, Positive, Real, Section, Text, Vec3
 
 Axis = Literal["x", "y", "z"]
 
@@ -362,70 +363,6 @@ WRITTEN_AS = {"principal_stress": tuple(f"principal_stress_{k}" for k in (1, 2, 
               "fibre_stretch": ("fibre_stretch_1", "fibre_stretch_2")}
 #: What a render may colour: a field, or an array one writes.
 Drawn = Literal[(*get_args(OutputField), *(name for names in WRITTEN_AS.values() for name in names))]
-#: The probes' vocabulary (one place: the schema, the probes and the renders read it).
-#: Quantities by kind; those read at the integration point nearest to a probe's set.
-VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
-TENSOR_QUANTITIES = ("stress", "strain")
-SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
-POINT_QUANTITIES = ("stress", "strain", "pressure_band")
-#: Global components: a vector's column, a tensor's (row, column).
-VECTOR_COMPONENTS = {"x": 0, "y": 1, "z": 2}
-TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
-
-
-#: Components of a vector or tensor probe in cylindrical axes about ``axis`` (through
-#: ``origin``), or along a given ``direction``; a tensor's is its normal component.
-AXIS_COMPONENTS = ("radial", "circumferential", "axial", "along")
-
-
-class Probe(Section):
-    """A history written at every output step: ``quantity`` at the node of a point set
-    (a set of several nodes gives their mean). ``stress`` (Cauchy), ``strain``
-    (Green-Lagrange) and ``pressure_band`` (-trace(stress) / 3) are read at the integration
-    point nearest to the set (mean through the thickness, global axes), as stress
-    benchmarks compare values at Gauss points. ``reaction`` is the force the supports
-    and prescribed motions exert on the set, summed over its nodes (each node's internal
-    less external force along the directions it is held in: the load a test rig would
-    measure). ``face`` reads a position or
-    displacement on the bottom or top face (along the director, half the current fibre
-    length from the mid-surface), e.g. the inner radius of a vessel.
-
-    Vessel axes: ``radial``, ``circumferential`` and ``axial`` components are taken in the
-    cylindrical axes about the line through ``origin`` along ``axis``, at the probe's
-    initial place (a position's radial component is its distance from the axis, a
-    stress's circumferential one the hoop stress); ``along`` takes the component along
-    ``direction``. Over a set of several nodes, each node's component is averaged (a
-    reaction's summed)."""
-
-    name: Name
-    quantity: Literal[VECTOR_QUANTITIES + TENSOR_QUANTITIES + SCALAR_QUANTITIES]
-    set: Name
-    component: Literal[(*VECTOR_COMPONENTS, "magnitude", *TENSOR_COMPONENTS, "scalar", *AXIS_COMPONENTS)] = "scalar"
-    face: Literal["bottom", "mid", "top"] = "mid"
-    axis: Vec3 = (0.0, 0.0, 1.0)
-    origin: Vec3 = (0.0, 0.0, 0.0)
-    direction: Vec3 | None = None
-
-    @model_validator(mode="after")
-    def _component_fits(self) -> "Probe":
-        if self.face != "mid" and self.quantity not in ("position", "displacement"):
-            raise ValueError(f"face = '{self.face}' reads a position or displacement, not {self.quantity}")
-        allowed = (
-            (*VECTOR_COMPONENTS, "magnitude", *AXIS_COMPONENTS) if self.quantity in VECTOR_QUANTITIES
-            else (*TENSOR_COMPONENTS, *AXIS_COMPONENTS) if self.quantity in TENSOR_QUANTITIES
-            else ("scalar",)
-        )
-        if self.component not in allowed:
-            raise ValueError(
-                f"component '{self.component}' does not fit quantity '{self.quantity}'; "
-                f"expected one of {', '.join(allowed)}"
-            )
-        if (self.component == "along") != (self.direction is not None):
-            raise ValueError("'direction' is needed with component = 'along', and only then")
-        need_directions(self, "axis", "direction")
-        return self
-
-
 class Render(Section):
     """PNGs written at the end of a completed run (as ``shellsim render``): ``field``
     (one of the written ``output.fields``, or an array one of them writes, e.g.
@@ -451,43 +388,7 @@ class Render(Section):
         return field
 
 
-class Valve(Section):
-    """``[output.valve]``: a valve's measures in history.csv (columns ``orifice_area``,
-    ``regurgitant_gap``, ``coaptation_area``, ``coaptation_height``,
-    ``peak_principal_stress``) and their final, smallest and largest values in
-    summary.json, for the ``leaflets`` (a surface set) hanging from the ``annulus`` (an edge
-    set), the valve's ``axis`` pointing downstream.
-
-    ``orifice_area``: the geometric orifice area, the inside of the annulus seen along the
-    axis that no leaflet's solid covers (read on a raster of ``resolution`` pixels across
-    the annulus: to about half a pixel along the orifice's edge); ``regurgitant_gap``: the
-    widest opening, the diameter of the largest disc that fits through the orifice (0 when
-    shut; to about a pixel); ``coaptation_area``: half the leaflets' surface carrying
-    contact force (each pair of coapting surfaces once); ``coaptation_height``: the extent
-    along the axis of the nodes in contact within a quarter of the annulus radius of the
-    axis, where the leaflets meet in the middle; ``peak_principal_stress``: the largest
-    principal Cauchy stress at the leaflets' integration points, every layer. A
-    measurement costs a raster and a stress evaluation, so it is taken at ``samples``
-    evenly spaced times (the history samples between hold nan in its columns)."""
-
-    #: The measures' history columns, each with what it measures (for units).
-    COLUMNS: ClassVar[dict[str, str]] = {"orifice_area": "area", "regurgitant_gap": "length",
-                                         "coaptation_area": "area", "coaptation_height": "length",
-                                         "peak_principal_stress": "stress"}
-
-    leaflets: Name = "all"
-    annulus: Name
-    axis: Vec3 = (0.0, 0.0, 1.0)
-    resolution: int = Field(default=400, ge=50, le=10000)
-    samples: int = Field(default=200, ge=1, le=100000)
-
-    @model_validator(mode="after")
-    def _axis_has_direction(self) -> "Valve":
-        need_directions(self, "axis")
-        return self
-
-
-class Output(Section):
+class _Output(Section):
     """``[output]``: frames at t = 0 and every ``interval`` (or at the listed ``times``,
     which the time stepper lands on exactly) and at the end; the ``fields`` written in
     them (stresses and strains per integration-point sub-cell, with a smoothed nodal
@@ -507,7 +408,8 @@ class Output(Section):
     stresses in (by default the material's, when they are a tube's or a centreline's);
     ``checkpoint_interval`` (explicit runs) writes checkpoint.npz at the first frame at or
     after each multiple of it, which ``shellsim run --resume FOLDER`` goes on from, to the
-    same answer; probes (history.csv), a valve's measures and renders."""
+    same answer; renders; and the tables of what a run measures into history.csv
+    (:mod:`shellsim.measures`: probes, a valve's measures)."""
 
     interval: Positive | None = None
     times: list[NonNegative] | None = None
@@ -521,12 +423,10 @@ class Output(Section):
     faces: list[Literal["bottom", "top"]] = []
     display_units: dict[Literal[tuple(UNIT_SIZES)], str] = {}
     checkpoint_interval: Positive | None = None
-    probe: list[Probe] = []
     render: list[Render] = []
-    valve: Valve | None = None
 
     @model_validator(mode="after")
-    def _one_schedule(self) -> "Output":
+    def _one_schedule(self) -> "_Output":
         if self.interval is not None and self.times is not None:
             raise ValueError("give either 'interval' or 'times', not both")
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
@@ -540,10 +440,11 @@ class Output(Section):
             if unit not in UNIT_SIZES[kind]:
                 raise ValueError(f"display_units.{kind} = '{unit}' is not a unit of {kind}; expected one of "
                                  f"{', '.join(UNIT_SIZES[kind])}")
-        duplicates = repeated([p.name for p in self.probe])
-        if duplicates:
-            raise ValueError(f"probe names must be unique; repeated: {', '.join(duplicates)}")
         return self
+
+
+#: ``[output]`` with each measure family's table (:data:`shellsim.measures.FAMILIES`).
+Output = create_model("Output", __base__=_Output, __module__=__name__, __doc__=_Output.__doc__, **OUTPUT_FIELDS)
 
 
 class Reference(Section):

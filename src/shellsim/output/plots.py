@@ -1,5 +1,5 @@
 """Line plots of a finished run (matplotlib, no display needed): each measured column that
-has a quantity of its own (:mod:`shellsim.deck.columns`: a probe's, a valve measure's)
+has a quantity of its own (:mod:`shellsim.measures`: a probe's, a valve measure's)
 against time, and against the load when one load follows a time curve
 (load-displacement curves such as the thesis' Figures 4.29 and 4.33), with the deck's
 references drawn on them; and the energies."""
@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..deck.columns import ENERGY_COLUMNS, measured_columns
+from ..deck.columns import ENERGY_COLUMNS
+from ..measures import measured_columns
 from ..deck.resolved import read_resolved
 from .folder import output_folder, refuse_link, replacing
 from .history import read_history

@@ -10,7 +10,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..deck.schema import TENSOR_COMPONENTS, VECTOR_COMPONENTS
+from ..measures.probes import TENSOR_COMPONENTS, VECTOR_COMPONENTS
 from ..element.shape import shape
 from ..errors import OutputError, ShellsimError
 from .encoding import SYMMETRIC_PAIRS

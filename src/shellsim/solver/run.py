@@ -23,7 +23,7 @@ from ..errors import NumericalError, OutputError, SceneTooLarge
 from ..loads import calibrate, needs_calibration, stable_step
 from ..mesh import Mesh
 from ..model import Model
-from .measures import Measure, resolve_measures
+from ..measures import Measure, resolve_measures
 from .relaxation import Relaxing
 from ..signals import STOP_SIGNALS, handling
 from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step

@@ -1,12 +1,13 @@
 """What contact carries: each ``[[contact]]`` table's force, contact area and spring
 energy (:class:`shellsim.loads.ToolForces`), a measure family
-(:mod:`shellsim.solver.measures`); its summary entry says what contact costs."""
+(:mod:`shellsim.measures`); its summary entry says what contact costs."""
 
 from __future__ import annotations
 
-from ...loads import ToolForces, measure_names
-from ...mesh import Mesh
-from ...model import Model
+from ..loads import ToolForces, measure_names
+from ..bundles import Model
+from ..mesh import Mesh
+from .column import Column
 
 
 class ContactMeasures:
@@ -30,6 +31,12 @@ class ContactMeasures:
         if run.deck.solver.method == "explicit" and run.sim.state.steps:
             record["share_of_step"] = per_evaluation * run.sim.state.steps / max(run.wall_time - output_seconds, 1e-300)
         return record
+
+
+def columns(deck) -> list[Column]:
+    """Each ``[[contact]]``'s force, contact area and spring energy."""
+    return [Column(column, f"contact[{i}].name", "a contact's") for i, contact in enumerate(deck.contact)
+            for column in measure_names([contact.name])]
 
 
 def resolve(deck, mesh: Mesh, model: Model) -> ContactMeasures | None:

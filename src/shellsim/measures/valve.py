@@ -1,6 +1,6 @@
 """Valve measures: what a deck's ``[output.valve]`` reads from a running simulation, resolved
 once on the mesh and read at the history samples it asks for; a measure family
-(:mod:`shellsim.solver.measures`) measured at some samples only.
+(:mod:`shellsim.measures`) measured at some samples only.
 
 The orifice is read on a raster of the plane across the valve's axis: the inside of the
 annulus (its nodes' ring seen along the axis) less the leaflets' shadow. A leaflet's shadow
@@ -13,20 +13,59 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numba import njit
+from pydantic import Field, model_validator
 from scipy.ndimage import distance_transform_edt
 
-from ...deck.schema import Valve as ValveTable
-from ...element.kinematics import fibre_point
-from ...element.shape import EDGES
-from ...loads import ToolForces
-from ...mesh import Mesh, node_areas
-from ...model import Model
+from ..bundles import Model
+from ..element.kinematics import fibre_point
+from ..element.shape import EDGES
+from ..loads import ToolForces
+from ..mesh import Mesh, node_areas
+from ..table_types import Name, Section, Vec3, need_directions
+from .column import Column
+
+class Valve(Section):
+    """``[output.valve]``: a valve's measures in history.csv (columns ``orifice_area``,
+    ``regurgitant_gap``, ``coaptation_area``, ``coaptation_height``,
+    ``peak_principal_stress``) and their final, smallest and largest values in
+    summary.json, for the ``leaflets`` (a surface set) hanging from the ``annulus`` (an edge
+    set), the valve's ``axis`` pointing downstream.
+
+    ``orifice_area``: the geometric orifice area, the inside of the annulus seen along the
+    axis that no leaflet's solid covers (read on a raster of ``resolution`` pixels across
+    the annulus: to about half a pixel along the orifice's edge); ``regurgitant_gap``: the
+    widest opening, the diameter of the largest disc that fits through the orifice (0 when
+    shut; to about a pixel); ``coaptation_area``: half the leaflets' surface carrying
+    contact force (each pair of coapting surfaces once); ``coaptation_height``: the extent
+    along the axis of the nodes in contact within a quarter of the annulus radius of the
+    axis, where the leaflets meet in the middle; ``peak_principal_stress``: the largest
+    principal Cauchy stress at the leaflets' integration points, every layer. A
+    measurement costs a raster and a stress evaluation, so it is taken at ``samples``
+    evenly spaced times (the history samples between hold nan in its columns)."""
+
+    #: The measures' history columns, each with what it measures (for units).
+    COLUMNS: ClassVar[dict[str, str]] = {"orifice_area": "area", "regurgitant_gap": "length",
+                                         "coaptation_area": "area", "coaptation_height": "length",
+                                         "peak_principal_stress": "stress"}
+
+    leaflets: Name = "all"
+    annulus: Name
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    resolution: int = Field(default=400, ge=50, le=10000)
+    samples: int = Field(default=200, ge=1, le=100000)
+
+    @model_validator(mode="after")
+    def _axis_has_direction(self) -> "Valve":
+        need_directions(self, "axis")
+        return self
+
 
 #: The measures' history columns, each with what it measures (for units).
-VALVE_COLUMNS = ValveTable.COLUMNS
+VALVE_COLUMNS = Valve.COLUMNS
 #: An element's boundary nodes in order around it (corner, mid-side, corner, ...).
 RIM = EDGES[:, :2].ravel()
 #: The halves of the element's edges, (node, next node along the edge) each. Shape (8, 2).
@@ -88,7 +127,7 @@ class ValveMeasures:
 
     def __call__(self, sim) -> dict[str, float]:
         """The measures now in ``sim`` (a :class:`shellsim.solver.simulation.Simulation`),
-        by column name: see :class:`shellsim.deck.schema.Valve`; nan for each while the
+        by column name: see :class:`Valve`; nan for each while the
         positions are no numbers (a run breaking down, its stability check next)."""
         state, conn = sim.state, sim.model.conn[self.elements]
         if not np.isfinite(state.x).all():
@@ -202,12 +241,23 @@ def widest_opening(open_pixels: np.ndarray) -> float:
     return float(2.0 * distance_transform_edt(window).max())
 
 
+#: Its table: ``[output.valve]``, one or none (:data:`shellsim.measures.FAMILIES`).
+TABLE, OUTPUT_KEY, OUTPUT_FIELD = Valve, "valve", (Valve | None, None)
+
+
+def columns(deck) -> list[Column]:
+    """The valve's measures, named by shellsim."""
+    valve = deck.output.valve
+    return [] if valve is None else [Column(name, "output.valve", "a valve measure's", quantity, chosen=False)
+                                     for name, quantity in valve.COLUMNS.items()]
+
+
 def resolve(deck, mesh: Mesh, model: Model) -> ValveMeasures | None:
     """The deck's ``[output.valve]`` placed on the mesh (None without one)."""
     return resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)
 
 
-def resolve_valve(table: ValveTable | None, mesh: Mesh, model: Model, end_time: float) -> ValveMeasures | None:
+def resolve_valve(table: Valve | None, mesh: Mesh, model: Model, end_time: float) -> ValveMeasures | None:
     """A ``[output.valve]`` table placed on the mesh of a run to ``end_time`` (None without
     one): the leaflets' elements, the annulus nodes ordered by angle about the axis through
     their centre, and a frame across the axis."""

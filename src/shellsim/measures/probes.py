@@ -1,24 +1,90 @@
 """Probes: what a deck's ``[[output.probe]]`` reads from a running simulation, resolved
 once on the mesh and read at every history sample; a measure family
-(:mod:`shellsim.solver.measures`) with a column per probe."""
+(:mod:`shellsim.measures`) with a column per probe, its deck table here."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import AfterValidator, model_validator
 
-from ...deck.schema import AXIS_COMPONENTS, POINT_QUANTITIES, TENSOR_COMPONENTS, VECTOR_COMPONENTS
-from ...deck.schema import Probe as ProbeTable
-from ...element.kinematics import fibre_point
-from ...element.sampling import nearest_integration_point, pressure_band, thickness_mean
-from ...errors import MeshError
-from ...mesh import FACES, Mesh
-from ...model import Model
+from ..bundles import Model
+from ..element.kinematics import fibre_point
+from ..element.sampling import nearest_integration_point, pressure_band, thickness_mean
+from ..errors import MeshError
+from ..mesh import FACES, Mesh
+from ..table_types import Name, Section, Vec3, need_directions, repeated
+from .column import Column
+
+
+#: The probes' vocabulary (one place: the deck, the probes and the renders read it).
+#: Quantities by kind; those read at the integration point nearest to a probe's set.
+VECTOR_QUANTITIES = ("displacement", "position", "director", "reaction")
+TENSOR_QUANTITIES = ("stress", "strain")
+SCALAR_QUANTITIES = ("thickness", "pressure_band", "rotation")
+POINT_QUANTITIES = ("stress", "strain", "pressure_band")
+#: Global components: a vector's column, a tensor's (row, column).
+VECTOR_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+TENSOR_COMPONENTS = {"xx": (0, 0), "yy": (1, 1), "zz": (2, 2), "xy": (0, 1), "yz": (1, 2), "zx": (2, 0)}
+
+
+#: Components of a vector or tensor probe in cylindrical axes about ``axis`` (through
+#: ``origin``), or along a given ``direction``; a tensor's is its normal component.
+AXIS_COMPONENTS = ("radial", "circumferential", "axial", "along")
+
+
+class Probe(Section):
+    """A history written at every output step: ``quantity`` at the node of a point set
+    (a set of several nodes gives their mean). ``stress`` (Cauchy), ``strain``
+    (Green-Lagrange) and ``pressure_band`` (-trace(stress) / 3) are read at the integration
+    point nearest to the set (mean through the thickness, global axes), as stress
+    benchmarks compare values at Gauss points. ``reaction`` is the force the supports
+    and prescribed motions exert on the set, summed over its nodes (each node's internal
+    less external force along the directions it is held in: the load a test rig would
+    measure). ``face`` reads a position or
+    displacement on the bottom or top face (along the director, half the current fibre
+    length from the mid-surface), e.g. the inner radius of a vessel.
+
+    Vessel axes: ``radial``, ``circumferential`` and ``axial`` components are taken in the
+    cylindrical axes about the line through ``origin`` along ``axis``, at the probe's
+    initial place (a position's radial component is its distance from the axis, a
+    stress's circumferential one the hoop stress); ``along`` takes the component along
+    ``direction``. Over a set of several nodes, each node's component is averaged (a
+    reaction's summed)."""
+
+    name: Name
+    quantity: Literal[VECTOR_QUANTITIES + TENSOR_QUANTITIES + SCALAR_QUANTITIES]
+    set: Name
+    component: Literal[(*VECTOR_COMPONENTS, "magnitude", *TENSOR_COMPONENTS, "scalar", *AXIS_COMPONENTS)] = "scalar"
+    face: Literal["bottom", "mid", "top"] = "mid"
+    axis: Vec3 = (0.0, 0.0, 1.0)
+    origin: Vec3 = (0.0, 0.0, 0.0)
+    direction: Vec3 | None = None
+
+    @model_validator(mode="after")
+    def _component_fits(self) -> "Probe":
+        if self.face != "mid" and self.quantity not in ("position", "displacement"):
+            raise ValueError(f"face = '{self.face}' reads a position or displacement, not {self.quantity}")
+        allowed = (
+            (*VECTOR_COMPONENTS, "magnitude", *AXIS_COMPONENTS) if self.quantity in VECTOR_QUANTITIES
+            else (*TENSOR_COMPONENTS, *AXIS_COMPONENTS) if self.quantity in TENSOR_QUANTITIES
+            else ("scalar",)
+        )
+        if self.component not in allowed:
+            raise ValueError(
+                f"component '{self.component}' does not fit quantity '{self.quantity}'; "
+                f"expected one of {', '.join(allowed)}"
+            )
+        if (self.component == "along") != (self.direction is not None):
+            raise ValueError("'direction' is needed with component = 'along', and only then")
+        need_directions(self, "axis", "direction")
+        return self
 
 
 @dataclass
-class Probe:
+class PlacedProbe:
     """Where a deck's probe reads: its nodes, quantity and component; for stress, the
     integration point (element, in-plane point) nearest to the nodes."""
 
@@ -34,7 +100,7 @@ class Probe:
     origin: np.ndarray | None = None  # (3,) of the axis, from which positions are taken
 
 
-def axis_directions(table: ProbeTable, places: np.ndarray) -> np.ndarray:
+def axis_directions(table: Probe, places: np.ndarray) -> np.ndarray:
     """Unit vectors (k, 3) of ``table.component`` (one of AXIS_COMPONENTS) at the initial
     ``places`` (k, 3): radial, circumferential (axis x radial) or axial about the table's
     axis through its origin, or its ``direction``. Raises MeshError for a place on the
@@ -54,7 +120,7 @@ def axis_directions(table: ProbeTable, places: np.ndarray) -> np.ndarray:
     return radial if table.component == "radial" else np.cross(axis, radial)
 
 
-def resolve_probes(tables: list[ProbeTable], mesh: Mesh, model: Model) -> list[Probe]:
+def resolve_probes(tables: list[Probe], mesh: Mesh, model: Model) -> list[PlacedProbe]:
     """The deck's probe tables placed on the mesh: nodes of their sets, for point
     quantities the integration point nearest to the set's centre, and the directions of
     axis components at those places."""
@@ -64,10 +130,10 @@ def resolve_probes(tables: list[ProbeTable], mesh: Mesh, model: Model) -> list[P
         nodes = mesh.sets[p.set].nodes
         if p.quantity in POINT_QUANTITIES:
             element, point = nearest_integration_point(model.x0, model.conn, gauss, model.x0[nodes].mean(axis=0))
-            probe = Probe(p.name, p.quantity, p.component, nodes, element, point)
+            probe = PlacedProbe(p.name, p.quantity, p.component, nodes, element, point)
             places = (gauss[point] @ model.x0[model.conn[element]])[None, :]
         else:
-            probe = Probe(p.name, p.quantity, p.component, nodes, face=FACES[p.face])
+            probe = PlacedProbe(p.name, p.quantity, p.component, nodes, face=FACES[p.face])
             places = model.x0[nodes]
         if p.component in AXIS_COMPONENTS:
             directions = axis_directions(p, places)
@@ -83,7 +149,7 @@ def held(projector: np.ndarray, force: np.ndarray) -> np.ndarray:
     return force - np.einsum("kij,kj->ki", projector, force)
 
 
-def probe_value(sim, probe: Probe) -> float:
+def probe_value(sim, probe: PlacedProbe) -> float:
     """The probe's current value in ``sim`` (a :class:`shellsim.solver.simulation.Simulation`;
     the mean over the probe's nodes)."""
     s, m = sim.state, sim.model
@@ -129,7 +195,7 @@ class Probes:
     NAME = "probes"
     sparse = False
 
-    def __init__(self, probes: list[Probe]):
+    def __init__(self, probes: list[PlacedProbe]):
         self.probes = probes
         self.columns = [p.name for p in probes]
 
@@ -138,6 +204,23 @@ class Probes:
 
     def record(self, run, output_seconds: float) -> None:
         """Probes have no summary entry of their own: references read their columns."""
+
+
+def _unique_names(probes: list[Probe]) -> list[Probe]:
+    duplicates = repeated([p.name for p in probes])
+    if duplicates:
+        raise ValueError(f"probe names must be unique; repeated: {', '.join(duplicates)}")
+    return probes
+
+
+#: Its tables: ``[[output.probe]]``, a list (:data:`shellsim.measures.FAMILIES`).
+TABLE, OUTPUT_KEY = Probe, "probe"
+OUTPUT_FIELD = (Annotated[list[Probe], AfterValidator(_unique_names)], [])
+
+
+def columns(deck) -> list[Column]:
+    """Each probe's column, its name."""
+    return [Column(p.name, f"output.probe[{i}].name", "a probe's", p.quantity) for i, p in enumerate(deck.output.probe)]
 
 
 def resolve(deck, mesh: Mesh, model: Model) -> Probes | None:

@@ -636,6 +636,7 @@ def test_display_units_convert_what_renders_and_plots_show():
     assert units.scale("hoop_stress") == 1e-3 and units.label("s", "cauchy_stress_nodal") == "s (kPa)"
     assert units.scale("pressure") == pytest.approx(1.0 / 133.322387415, rel=1e-15)
     assert units.scale("area") == pytest.approx(1e6, rel=1e-15) and units.label("A", "area") == "A (mm^2)"
+    assert units.scale("volume") == pytest.approx(1e9, rel=1e-15) and units.label("V", "volume") == "V (mm^3)"
     assert units.scale("time") == 1.0 and units.label("t", "time") == "t (s)"
     assert DisplayUnits("mm-kg-ms", {"stress": "kPa", "time": "s"}).scale("pressure") == pytest.approx(1e6)
     assert DisplayUnits("mm-kg-ms", {"time": "s"}).scale("time") == pytest.approx(1e-3)

@@ -15,13 +15,15 @@ FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "leng
               "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
               "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time",
               **dict.fromkeys((*WRITTEN_AS["principal_stress"], *WRITTEN_AS["vessel_stress"]), "stress")}
+#: Kinds that are a power of another: (base kind, power).
+POWERS = {"area": ("length", 2), "volume": ("length", 3)}
 
 
 @dataclass(frozen=True)
 class DisplayUnits:
     """Units of a deck's unit ``system`` (SYSTEMS' keys), with the ``shown`` ones (kind:
     unit) instead where given. A field or quantity of kind length, stress, pressure, time
-    or area (length squared) has a unit; others are drawn as they are."""
+    or area and volume (:data:`POWERS`) has a unit; others are drawn as they are."""
 
     system: str = "consistent"
     shown: dict[str, str] = field(default_factory=dict)
@@ -31,12 +33,12 @@ class DisplayUnits:
         return cls(deck.meta.units, dict(deck.output.display_units))
 
     def _kind(self, name: str) -> tuple[str, int]:
-        """(base kind, power) of a field, quantity or kind: area is length squared."""
+        """(base kind, power) of a field, quantity or kind: an area is length squared."""
         field = name.removesuffix(NODAL_SUFFIX)
         for suffix in FACE_SUFFIXES:
             field = field.removesuffix(suffix)
         kind = FIELD_KIND.get(field, field)
-        return ("length", 2) if kind == "area" else (kind, 1)
+        return POWERS.get(kind, (kind, 1))
 
     def _shown(self, kind: str) -> str | None:
         """The unit asked for ``kind``: a pressure's follows the stresses' unless given."""

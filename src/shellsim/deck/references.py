@@ -10,7 +10,7 @@ from __future__ import annotations
 import difflib
 
 from ..loads import DECK_KEYS
-from ..measures import measured_columns
+from ..measures import measured_columns, measured_sets
 from .columns import column_clashes
 from .schema import Deck
 
@@ -83,12 +83,8 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
                 need_set(f"{key}[{i}].{name_key}", name, table.SET_KINDS)
             need_curve(f"{key}[{i}].curve", getattr(table, "curve", None))
     problems += column_clashes(deck)
-    valve = deck.output.valve
-    if valve is not None:
-        need_set("output.valve.leaflets", valve.leaflets, ("surface",))
-        need_set("output.valve.annulus", valve.annulus, ("edge", "point"))
-    for i, probe in enumerate(deck.output.probe):
-        need_set(f"output.probe[{i}].set", probe.set)
+    for path, name, kinds in measured_sets(deck):
+        need_set(path, name, kinds)
     probes = [column.name for column in measured_columns(deck)]
     for i, ref in enumerate(deck.reference):
         if ref.probe not in probes:

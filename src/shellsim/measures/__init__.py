@@ -6,9 +6,10 @@ A family is a module with
   the deck key that asks for it), in order; the deck checks them before anything runs;
 - ``resolve(deck, mesh, model)``: its measures placed on the scene, a :class:`Measure`
   (None where the deck asks for none);
-- where a deck table asks for it, ``OUTPUT_KEY`` and ``OUTPUT_FIELD``: its key in
-  ``[output]`` and (annotation, default), which the deck's ``[output]`` section is built
-  with.
+- where a deck table asks for it, ``TABLE``, ``OUTPUT_KEY`` and ``OUTPUT_FIELD``: the
+  table, its key in ``[output]`` and (annotation, default), which the deck's ``[output]``
+  section is built with; and ``named_sets(deck)``: (deck key, set name, the set kinds it
+  may be) of each set its tables name, which the deck checks against the geometry.
 A new family is a module here and a line in :data:`FAMILIES`. The families sit below the
 deck (which builds its ``[output]`` from them) and read the running scene duck-typed.
 """
@@ -53,6 +54,11 @@ OUTPUT_FIELDS = {family.OUTPUT_KEY: family.OUTPUT_FIELD for family in FAMILIES i
 def measured_columns(deck) -> list[Column]:
     """Every measured column of ``deck``'s history, in order."""
     return [column for family in FAMILIES for column in family.columns(deck)]
+
+
+def measured_sets(deck) -> list[tuple[str, str, tuple[str, ...]]]:
+    """(deck key, set name, kinds it may be) of every set the measures of ``deck`` read."""
+    return [named for family in FAMILIES if hasattr(family, "named_sets") for named in family.named_sets(deck)]
 
 
 def resolve_measures(deck, mesh: Mesh, model: Model) -> list[Measure]:

@@ -223,6 +223,11 @@ def columns(deck) -> list[Column]:
     return [Column(p.name, f"output.probe[{i}].name", "a probe's", p.quantity) for i, p in enumerate(deck.output.probe)]
 
 
+def named_sets(deck) -> list[tuple[str, str, tuple[str, ...]]]:
+    """Each probe's set, of any kind."""
+    return [(f"output.probe[{i}].set", p.set, ("surface", "edge", "point")) for i, p in enumerate(deck.output.probe)]
+
+
 def resolve(deck, mesh: Mesh, model: Model) -> Probes | None:
     """The deck's probes on the mesh (None without any)."""
     probes = resolve_probes(deck.output.probe, mesh, model)

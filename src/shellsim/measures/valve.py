@@ -252,6 +252,13 @@ def columns(deck) -> list[Column]:
                                      for name, quantity in valve.COLUMNS.items()]
 
 
+def named_sets(deck) -> list[tuple[str, str, tuple[str, ...]]]:
+    """The leaflets (a surface set) and the annulus (an edge or point set)."""
+    valve = deck.output.valve
+    return [] if valve is None else [("output.valve.leaflets", valve.leaflets, ("surface",)),
+                                     ("output.valve.annulus", valve.annulus, ("edge", "point"))]
+
+
 def resolve(deck, mesh: Mesh, model: Model) -> ValveMeasures | None:
     """The deck's ``[output.valve]`` placed on the mesh (None without one)."""
     return resolve_valve(deck.output.valve, mesh, model, deck.solver.end_time)

@@ -20,7 +20,7 @@ from typing import Protocol
 
 from ..bundles import Model
 from ..mesh import Mesh
-from . import contact, load_factors, probes, valve
+from . import contact, load_factors, lumen, probes, valve
 from .column import Column
 
 
@@ -46,7 +46,7 @@ class Measure(Protocol):
 
 
 #: Every family, in the order of their columns in history.csv.
-FAMILIES = (probes, load_factors, contact, valve)
+FAMILIES = (probes, load_factors, contact, valve, lumen)
 #: The ``[output]`` keys the families' tables take: key -> (annotation, default).
 OUTPUT_FIELDS = {family.OUTPUT_KEY: family.OUTPUT_FIELD for family in FAMILIES if hasattr(family, "OUTPUT_KEY")}
 

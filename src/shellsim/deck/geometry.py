@@ -2,7 +2,10 @@
 
 Each model declares what its builder produces, so a deck can be checked against it
 without meshing: ``DIVISIONS`` (the names of the ``[mesh] divisions`` it reads, with their
-defaults) and :meth:`sets` (named sets and their kind: ``surface``, ``edge`` or ``point``).
+defaults), ``EVEN`` (the divisions that must be even, each with why), ``IRREGULAR``
+(whether it takes ``[mesh] boundaries_y0/_y1``) and :meth:`sets` (named sets and their
+kind: ``surface``, ``edge`` or ``point``); :func:`division_problems` checks a deck's
+``[mesh]`` against them.
 The builders in :mod:`shellsim.geometry.builders` create exactly these sets (tested).
 Every mesh also has the surface set ``all``.
 """
@@ -30,6 +33,7 @@ class Rectangle(Section):
     length: Positive
     width: Positive
     DIVISIONS: ClassVar[dict[str, int]] = {"length": 2, "width": 2}
+    IRREGULAR: ClassVar[bool] = True
 
     def sets(self) -> SetKinds:
         return _edges("x0", "x1", "y0", "y1") | _points("x0y0", "x1y0", "x1y1", "x0y1")
@@ -69,6 +73,7 @@ class TwistedStrip(Section):
     width: Positive
     twist_deg: Annotated[float, Field(strict=True, ge=-180, le=180)] = 90.0
     DIVISIONS: ClassVar[dict[str, int]] = {"length": 4, "width": 2}
+    EVEN: ClassVar[dict[str, str]] = {"width": "so the tip centre is a node"}
 
     def sets(self) -> SetKinds:
         return _edges("root", "tip", "side0", "side1") | _points("tip_centre")
@@ -145,6 +150,7 @@ class Tube(Section):
     length: Positive
     cap: Literal["none", "hemisphere"] = "none"
     DIVISIONS: ClassVar[dict[str, int]] = {"around": 2, "axial": 8}
+    EVEN: ClassVar[dict[str, str]] = {"around": "as the tube is built from two 45-degree patches"}
 
     def sets(self) -> SetKinds:
         sets = {"wall": "surface"} | _edges("sym_x", "sym_y", "z0") | _points("z0_x", "z0_y")
@@ -213,6 +219,7 @@ class AorticValve(Section):
     coaptation_height: Positive = 2.0
     gap: Positive = 0.5
     DIVISIONS: ClassVar[dict[str, int]] = {"around": 8, "belly": 4, "coaptation": 1}
+    EVEN: ClassVar[dict[str, str]] = {"around": "so that each free edge's middle is a node"}
     LEAFLETS: ClassVar[int] = 3
 
     def sets(self) -> SetKinds:
@@ -300,6 +307,24 @@ def lengths(geometry: Section) -> dict[str, float]:
     if isinstance(geometry, MeshFile):
         return {}
     return {k: v for k, v in geometry.model_dump().items() if isinstance(v, float) and not k.endswith("_deg")}
+
+
+def division_problems(geometry: Section, mesh) -> list[str]:
+    """What is wrong with ``mesh`` (the deck's ``[mesh]``) for ``geometry``'s builder: a
+    division it does not read, an odd one it needs even (``EVEN``), irregular element
+    boundaries where it takes none (``IRREGULAR``) or of the wrong count."""
+    known, even = type(geometry).DIVISIONS, getattr(geometry, "EVEN", {})
+    problems = [f"mesh.divisions.{name}: builder '{geometry.builder}' has no division '{name}'; expected "
+                f"{', '.join(known) or 'none (the file sets the mesh)'}" for name in mesh.divisions if name not in known]
+    problems += [f"mesh.divisions.{name}: must be even {why}, got {mesh.divisions[name]}"
+                 for name, why in even.items() if mesh.divisions.get(name, known[name]) % 2]
+    if (mesh.boundaries_y0 or mesh.boundaries_y1) and not getattr(geometry, "IRREGULAR", False):
+        problems.append(f"mesh.boundaries_y0/_y1: builder '{geometry.builder}' takes no irregular element boundaries")
+    for key in ("boundaries_y0", "boundaries_y1"):
+        b, n = getattr(mesh, key), mesh.divisions.get("length")
+        if b is not None and n is not None and len(b) != n + 1:
+            problems.append(f"mesh.{key}: {len(b)} boundaries for divisions.length = {n}; expected {n + 1}")
+    return problems
 
 
 def proportion_problems(geometry: Section, thickness: float) -> list[str]:

@@ -15,7 +15,8 @@ import numpy as np
 from pydantic import BeforeValidator, Field, create_model, field_validator, model_validator
 
 from .curves import Curve
-from .geometry import BUILDERS, Geometry, proportion_problems
+from .output_fields import FIELD_KINDS, WRITTEN_AS, field_problems
+from .geometry import BUILDERS, Geometry, division_problems, proportion_problems
 from .material import MATERIALS, Material
 from ..materials.axes import CentrelineAxes, CylindricalAxes
 from ..loads import CABLE_TABLES, CONTACT_TABLES
@@ -346,21 +347,10 @@ class Solver(Section):
         return self.end_time if self.method == "static" else self.preload
 
 
-OutputField = Literal[
-    "displacement", "director", "thickness", "cauchy_stress", "lamina_stress",
-    "pressure_band", "green_lagrange_strain", "von_mises", "principal_stress", "vessel_stress", "fibres",
-    "fibre_stretch", "contact_pressure", "contact_gap", "pk2_stress", "material_stress",
-]
+#: A field a frame may hold (:data:`shellsim.deck.output_fields.FIELDS`).
+OutputField = Literal[tuple(FIELD_KINDS)]
 #: The axes a vessel's stresses are read in: a tube's or a curved vessel's.
 VesselAxes = Annotated[Union[CylindricalAxes, CentrelineAxes], Field(discriminator="kind")]
-#: Fields a fibre-reinforced law alone has.
-FIBRE_FIELDS = ("fibres", "fibre_stretch")
-#: Fields in the material's axes, which a hyperelastic law (Technique 1) alone has.
-MATERIAL_AXES_FIELDS = ("pk2_stress", "material_stress")
-#: The scalar arrays a field writes under other names, by the field (a render draws them).
-WRITTEN_AS = {"principal_stress": tuple(f"principal_stress_{k}" for k in (1, 2, 3)),
-              "vessel_stress": ("hoop_stress", "axial_stress", "radial_stress"),
-              "fibre_stretch": ("fibre_stretch_1", "fibre_stretch_2")}
 #: What a render may colour: a field, or an array one writes.
 Drawn = Literal[(*get_args(OutputField), *(name for names in WRITTEN_AS.values() for name in names))]
 class Render(Section):
@@ -436,6 +426,9 @@ class _Output(Section):
         unwritten = sorted(drawn - set(self.fields))
         if unwritten:
             raise ValueError(f"render field(s) {', '.join(unwritten)} must also be in 'fields'")
+        if self.vessel_axes is not None and self.vessel_axes.angle_deg != 0.0:
+            raise ValueError(f"vessel_axes.angle_deg = {self.vessel_axes.angle_deg}: a vessel's axes are not turned; "
+                             "leave it out")
         for kind, unit in self.display_units.items():
             if unit not in UNIT_SIZES[kind]:
                 raise ValueError(f"display_units.{kind} = '{unit}' is not a unit of {kind}; expected one of "
@@ -532,18 +525,6 @@ def _mirror_problems(mirror: bool | list[str], boundaries: list) -> list[str]:
     return problems
 
 
-def _vessel_axes_problems(output: Output) -> list[str]:
-    """``vessel_stress`` needs vessel axes, which are not turned."""
-    if "vessel_stress" in output.fields and output.vessel_axes is None:
-        return ["output.fields: 'vessel_stress' reads the stress in a vessel's axes: give output.vessel_axes = "
-                "{ kind = 'cylindrical', axis = [...], origin = [...] } or { kind = 'centreline', points = [...] } "
-                "(a fibre-reinforced material's own tube or centreline axes serve when it has them)"]
-    if output.vessel_axes is not None and output.vessel_axes.angle_deg != 0.0:
-        return [f"output.vessel_axes.angle_deg = {output.vessel_axes.angle_deg}: a vessel's axes are not turned; "
-                "leave it out"]
-    return []
-
-
 class Deck(Section):
     """A whole scene. Tables may come in any order; names are resolved after parsing."""
 
@@ -595,55 +576,13 @@ class Deck(Section):
 
     @model_validator(mode="after")
     def _consistent(self) -> "Deck":
-        problems = []
-        known = type(self.geometry).DIVISIONS
-        for name in self.mesh.divisions:
-            if name not in known:
-                problems.append(
-                    f"mesh.divisions.{name}: builder '{self.geometry.builder}' has no division "
-                    f"'{name}'; expected {', '.join(known) or 'none (the file sets the mesh)'}"
-                )
-        if (self.mesh.boundaries_y0 or self.mesh.boundaries_y1) and self.geometry.builder != "rectangle":
-            problems.append("mesh.boundaries_y0/_y1: irregular element boundaries are for builder 'rectangle' only")
-        for key in ("boundaries_y0", "boundaries_y1"):
-            b = getattr(self.mesh, key)
-            n = self.mesh.divisions.get("length")
-            if b is not None and n is not None and len(b) != n + 1:
-                problems.append(
-                    f"mesh.{key}: {len(b)} boundaries for divisions.length = {n}; expected {n + 1}"
-                )
-        if self.geometry.builder == "tube" and self.mesh.divisions.get("around", 2) % 2:
-            problems.append(
-                f"mesh.divisions.around: the tube is built from two 45-degree patches, so it "
-                f"must be even, got {self.mesh.divisions['around']}"
-            )
-        if self.geometry.builder == "aortic_valve" and self.mesh.divisions.get("around", 2) % 2:
-            problems.append(
-                f"mesh.divisions.around: must be even so that each free edge's middle is a node, "
-                f"got {self.mesh.divisions['around']}"
-            )
-        if self.geometry.builder == "twisted_strip" and self.mesh.divisions.get("width", 2) % 2:
-            problems.append(
-                f"mesh.divisions.width: must be even so the tip centre is a node, "
-                f"got {self.mesh.divisions['width']}"
-            )
+        problems = division_problems(self.geometry, self.mesh)
         problems += _constitutive_path_problems(self.material, self.section)
         problems += _mirror_problems(self.output.mirror, self.boundary)
-        problems += [f"output.fields: '{name}' is the {what} of the [[contact]] tables, and the deck has none"
-                     for name, what in (("contact_pressure", "pressure"), ("contact_gap", "gap"))
-                     if name in self.output.fields and not self.contact]
-        if not self.material.ANISOTROPIC:
-            problems += [f"output.fields: '{name}' is of a fibre-reinforced law's fibres, and material.model = "
-                         f"'{self.material.model}' has none" for name in FIBRE_FIELDS if name in self.output.fields]
+        problems += field_problems(self)
         if self.output.checkpoint_interval is not None and self.solver.method == "static":
             problems.append(f"output.checkpoint_interval = {self.output.checkpoint_interval:g}: checkpoints are of "
                             "the explicit time loop, and solver.method = 'static' solves in load steps; drop it")
-        if self.section.technique != 1:
-            problems += [f"output.fields: '{name}' is in the axes of a hyperelastic material (section.technique = 1), "
-                         f"and material.model = '{self.material.model}' with section.technique = "
-                         f"{self.section.technique} has none" for name in MATERIAL_AXES_FIELDS
-                         if name in self.output.fields]
-        problems += _vessel_axes_problems(self.output)
         if self.output.display_units and self.meta.units == "consistent":
             problems.append("output.display_units: meta.units = 'consistent' names no units to convert from; give "
                             f"meta.units (one of {', '.join(u for u in SYSTEMS if u != 'consistent')})")

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..deck.schema import WRITTEN_AS
+from ..deck.output_fields import WRITTEN_AS
 from ..mesh import layer_geometry
 from ..model import lamina_axes
 from ..solver.simulation import Simulation

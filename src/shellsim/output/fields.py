@@ -16,11 +16,12 @@ the solid view, the middle layer's in the shell view.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 
-from ..deck.schema import WRITTEN_AS
+from ..deck.output_fields import FIELD_KINDS, FIELDS, WRITTEN_AS
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import NODE_RS, gauss_rule, shape
 from ..materials.laws import LAWS
@@ -34,19 +35,9 @@ from .derived import (VESSEL_STRESSES, current_material_frames, deformation_grad
 from .encoding import symmetric_columns
 from .units import NODAL_SUFFIX
 
-POINT_FIELDS = ("displacement", "director", "thickness")
-CELL_FIELDS = ("cauchy_stress", "lamina_stress", "pressure_band", "green_lagrange_strain", "von_mises", "pk2_stress",
-               "material_stress")
-#: Tensor fields in the material's axes: the second Piola-Kirchhoff stress in the initial
-#: ones, the Cauchy stress in the current ones.
-PK2, MATERIAL_STRESS = "pk2_stress", "material_stress"
-#: Fields derived from the Cauchy stress, cells only: principal_stress_k and
-#: principal_direction_k (k = 1, 2, 3, largest first); hoop_, axial_ and radial_stress.
-PRINCIPAL, VESSEL = "principal_stress", "vessel_stress"
 #: The output field of fibre directions, written as one cell vector per family:
 #: fibre_1, fibre_2, ...; and of their stretches, fibre_stretch_1, ...
-FIBRES, FIBRE_PREFIX, FIBRE_STRETCH = "fibres", "fibre_", "fibre_stretch"
-CONTACT_PRESSURE, CONTACT_GAP = "contact_pressure", "contact_gap"
+FIBRE_PREFIX = "fibre_"
 #: Fields the shell view shows as their largest value through the thickness (a bent
 #: shell's equivalent stress peaks at its faces); the others as the thickness mean.
 LARGEST_THROUGH_THICKNESS = ("von_mises",)
@@ -168,25 +159,6 @@ def von_mises(sigma: np.ndarray) -> np.ndarray:
     return np.sqrt(1.5 * np.einsum("...ij,...ij->...", deviator, deviator))
 
 
-def _point_values(sim: Simulation, tensors: tuple[np.ndarray, ...], fields: list[str]) -> dict[str, np.ndarray]:
-    """Each requested cell field at every integration point, (ne, nq, nt, ...), from the
-    (lamina, Cauchy, Green-Lagrange) tensors there."""
-    lamina, cauchy, green = tensors
-    values = {"cauchy_stress": cauchy, "lamina_stress": lamina, "green_lagrange_strain": green,
-              "pressure_band": pressure_band(cauchy)}
-    if "von_mises" in fields:
-        values["von_mises"] = von_mises(cauchy)
-    if {PK2, MATERIAL_STRESS} & set(fields):
-        F, jac = deformation_gradients(sim, list(range(len(sim.model.rule.tz))))
-        frames0 = sim.model.material.axes0
-        if PK2 in fields:
-            values[PK2] = second_piola_in(frames0, F, cauchy)
-        if MATERIAL_STRESS in fields:
-            frames = current_material_frames(frames0, F, jac)
-            values[MATERIAL_STRESS] = frames @ cauchy @ np.swapaxes(frames, -1, -2)
-    return {name: values[name] for name in fields if name in CELL_FIELDS}
-
-
 def contact_pressure(sim: Simulation, mesh: OutputMesh) -> np.ndarray:
     """(n,) the contact tools' force on each node over the node's share of the initial
     mid-surface (``mesh.node_areas``): the pressure the tools put on the shell; 0 at a
@@ -230,22 +202,121 @@ def _on_cells(values: np.ndarray, mesh: OutputMesh) -> np.ndarray:
     return np.swapaxes(values, 1, 2).reshape(len(mesh.cells), *values.shape[3:])
 
 
-def _stress_measures(sim: Simulation, cauchy: np.ndarray, depths: np.ndarray, fields: list[str], vessel_axes,
-                     mesh: OutputMesh, suffix: str = "") -> dict[str, np.ndarray]:
-    """The principal and vessel stresses asked for, as cell arrays named with ``suffix``,
-    of the Cauchy stresses (ne, nq, L, 3, 3) on the view's L layers at thickness
-    coordinates ``depths`` (L,)."""
-    measures = {}
-    if PRINCIPAL in fields:
-        values, directions = principal_stresses(cauchy)
-        for k, name in enumerate(WRITTEN_AS[PRINCIPAL]):
-            measures[name + suffix] = _on_cells(values[..., k], mesh)
-            measures[f"principal_direction_{k + 1}{suffix}"] = _on_cells(directions[..., k, :], mesh)
-    if VESSEL in fields:
-        frames = vessel_frames(sim, vessel_axes, depths)
-        for name, values in zip(VESSEL_STRESSES, np.moveaxis(normal_components(cauchy, frames), -1, 0)):
-            measures[name + suffix] = _on_cells(values, mesh)
-    return measures
+class Frame:
+    """What one frame's fields are computed from: the simulation ``sim`` now, the view
+    ``mesh`` and the ``vessel_axes``; each intermediate the fields share (the tensors at
+    the integration points, the fibres' vectors) computed once, when a field first asks."""
+
+    def __init__(self, sim: Simulation, mesh: OutputMesh, vessel_axes=None):
+        self.sim, self.mesh, self.vessel_axes = sim, mesh, vessel_axes
+
+    @cached_property
+    def tensors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lamina stress, Cauchy stress, Green-Lagrange strain) at every integration point,
+        (ne, nq, nt, 3, 3) each."""
+        return self.sim.point_tensors()
+
+    def cauchy(self, layer: int | None) -> tuple[np.ndarray, np.ndarray]:
+        """(Cauchy stresses (ne, nq, L, 3, 3), their thickness coordinates (L,)) of the view
+        (``layer`` None: every layer in the solid view, the thickness mean in the shell
+        view) or of the integration layer ``layer``."""
+        cauchy, rule = self.tensors[1], self.sim.model.rule
+        if layer is not None:
+            return cauchy[:, :, layer:layer + 1], rule.tz[layer:layer + 1]
+        if self.mesh.solid:
+            return cauchy, rule.tz
+        return thickness_mean(cauchy, rule.wt, axis=2)[:, :, None], np.zeros(1)
+
+    @cached_property
+    def fibre_vectors(self) -> list[np.ndarray]:
+        """Each fibre family's current vector (ne, nq, L, 3) on the view's layers: every
+        layer in the solid view, the middle one in the shell view (:func:`fibre_vectors`)."""
+        nt = len(self.sim.model.rule.tz)
+        return fibre_vectors(self.sim, list(range(nt)) if self.mesh.solid else [nt // 2])
+
+    def on_corners(self, nodal: np.ndarray, weights: np.ndarray = CORNER_N) -> np.ndarray:
+        """Nodal values (n, ...) on the view's points (:func:`_at_corners`)."""
+        return _at_corners(nodal, self.sim.model.conn, len(self.mesh.layers), weights)
+
+
+# The fields' functions, one per field of :data:`shellsim.deck.output_fields.FIELDS`, by
+# where it lives: a node field's gives its values on the view's points (P, ...); a point
+# field's its values at every integration point (ne, nq, nt) or (ne, nq, nt, 3, 3); a
+# cell field's, of the view (``layer`` None) or of one integration layer, its arrays by
+# name, (ne, nq, L, ...) on the L layers.
+
+def _displacement(frame: Frame) -> np.ndarray:
+    state, model = frame.sim.state, frame.sim.model
+    return _corner_points(state.x, state.d, state.h, model.conn, frame.mesh.layers) - frame.mesh.points
+
+
+def _director(frame: Frame) -> np.ndarray:
+    director = frame.on_corners(frame.sim.state.d)
+    return director / np.linalg.norm(director, axis=1, keepdims=True)
+
+
+def _contact_gap(frame: Frame) -> np.ndarray:
+    sim = frame.sim
+    return frame.on_corners(ToolForces(sim.model, []).gaps(sim.state.t, sim.state.fields.shape), CORNER_HATS)
+
+
+def _material_stress(frame: Frame) -> np.ndarray:
+    F, jac = deformation_gradients(frame.sim, list(range(len(frame.sim.model.rule.tz))))
+    frames = current_material_frames(frame.sim.model.material.axes0, F, jac)
+    return frames @ frame.tensors[1] @ np.swapaxes(frames, -1, -2)
+
+
+def _pk2_stress(frame: Frame) -> np.ndarray:
+    F, _ = deformation_gradients(frame.sim, list(range(len(frame.sim.model.rule.tz))))
+    return second_piola_in(frame.sim.model.material.axes0, F, frame.tensors[1])
+
+
+def _principal_stress(frame: Frame, layer: int | None) -> dict[str, np.ndarray]:
+    values, directions = principal_stresses(frame.cauchy(layer)[0])
+    arrays = {}
+    for k, name in enumerate(WRITTEN_AS["principal_stress"]):
+        arrays[name], arrays[f"principal_direction_{k + 1}"] = values[..., k], directions[..., k, :]
+    return arrays
+
+
+def _vessel_stress(frame: Frame, layer: int | None) -> dict[str, np.ndarray]:
+    cauchy, depths = frame.cauchy(layer)
+    stresses = normal_components(cauchy, vessel_frames(frame.sim, frame.vessel_axes, depths))
+    return dict(zip(VESSEL_STRESSES, np.moveaxis(stresses, -1, 0)))
+
+
+def _fibres(frame: Frame, layer: int | None) -> dict[str, np.ndarray]:
+    return {f"{FIBRE_PREFIX}{family}": vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+            for family, vectors in enumerate(frame.fibre_vectors, start=1)}
+
+
+def _fibre_stretch(frame: Frame, layer: int | None) -> dict[str, np.ndarray]:
+    return {f"fibre_stretch_{family}": np.linalg.norm(vectors, axis=-1)
+            for family, vectors in enumerate(frame.fibre_vectors, start=1)}
+
+
+#: Each field's function, by its name.
+COMPUTE = {
+    "displacement": _displacement,
+    "director": _director,
+    "thickness": lambda frame: frame.on_corners(frame.sim.state.h),
+    "cauchy_stress": lambda frame: frame.tensors[1],
+    "lamina_stress": lambda frame: frame.tensors[0],
+    "pressure_band": lambda frame: pressure_band(frame.tensors[1]),
+    "green_lagrange_strain": lambda frame: frame.tensors[2],
+    "von_mises": lambda frame: von_mises(frame.tensors[1]),
+    "pk2_stress": _pk2_stress,
+    "material_stress": _material_stress,
+    "contact_pressure": lambda frame: frame.on_corners(contact_pressure(frame.sim, frame.mesh), CORNER_HATS),
+    "contact_gap": _contact_gap,
+    "principal_stress": _principal_stress,
+    "vessel_stress": _vessel_stress,
+    "fibres": _fibres,
+    "fibre_stretch": _fibre_stretch,
+}
+if set(COMPUTE) != set(FIELD_KINDS):  # a declared field without its function, or one the deck cannot ask for
+    raise ImportError(f"output fields declared without a function: {sorted(set(FIELD_KINDS) - set(COMPUTE))}; "
+                      f"functions of no declared field: {sorted(set(COMPUTE) - set(FIELD_KINDS))}")
 
 
 def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_axes=None,
@@ -253,52 +324,38 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
     """(point_data, cell_data) of the current state for the requested ``fields``: arrays
     of shape (P,), (P, 3) or (P, 6) on the points, (C,), (C, 3) or (C, 6) on the cells;
     the tensors, all symmetric, as their six components (:data:`SYMMETRIC_PAIRS`);
-    ``vessel_axes`` (a tube's or centreline's axes) for ``vessel_stress``. In the shell
-    view, each stress and strain field also at the integration layer nearest each of the
-    ``faces`` ("bottom", "top"), as ``<name>_bottom``, ``<name>_top``."""
-    model, state = sim.model, sim.state
+    ``vessel_axes`` (a tube's or centreline's axes) for ``vessel_stress``. A point field
+    is written per sub-cell (the shell view: its thickness mean, or its largest value
+    through the thickness, :data:`LARGEST_THROUGH_THICKNESS`) with a smoothed
+    ``<name>_nodal``. In the shell view, each point field and each cell field with
+    ``faces`` also at the integration layer nearest each of the ``faces`` ("bottom",
+    "top"), as ``<name>_bottom``, ``<name>_top``."""
+    frame, model = Frame(sim, mesh, vessel_axes), sim.model
+    kinds = [kind for kind in FIELDS if kind.name in fields]
     point_data: dict[str, np.ndarray] = {}
-    if "displacement" in fields:
-        point_data["displacement"] = _corner_points(state.x, state.d, state.h, model.conn, mesh.layers) - mesh.points
-    if "director" in fields:
-        director = _at_corners(state.d, model.conn, len(mesh.layers))
-        point_data["director"] = director / np.linalg.norm(director, axis=1, keepdims=True)
-    if "thickness" in fields:
-        point_data["thickness"] = _at_corners(state.h, model.conn, len(mesh.layers))
     cell_data: dict[str, np.ndarray] = {}
-    tensors = sim.point_tensors() if set(fields) & {*CELL_FIELDS, PRINCIPAL, VESSEL} else None
-    flats = {name: symmetric_columns(values) if values.ndim == 5 else values[..., None]  # (ne, nq, nt, 6 or 1)
-             for name, values in (_point_values(sim, tensors, fields) if tensors is not None else {}).items()}
-    for name, flat in flats.items():
-        if mesh.solid:
-            cell_data[name] = _columns(_on_cells(flat, mesh))
+    flats = {}  # each point field's values (ne, nq, nt, 6 or 1)
+    for kind in kinds:
+        values = COMPUTE[kind.name](frame) if kind.lives != "cell" else None
+        if kind.lives == "node":
+            point_data[kind.name] = values
+        elif kind.lives == "point":
+            flat = flats[kind.name] = symmetric_columns(values) if values.ndim == 5 else values[..., None]
+            if mesh.solid:
+                cell_data[kind.name] = _columns(_on_cells(flat, mesh))
+            else:
+                through = (flat.max(axis=2) if kind.name in LARGEST_THROUGH_THICKNESS
+                           else thickness_mean(flat, model.rule.wt, axis=2))
+                cell_data[kind.name] = _columns(through.reshape(len(mesh.cells), -1))
+                point_data[kind.name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
         else:
-            through = flat.max(axis=2) if name in LARGEST_THROUGH_THICKNESS else thickness_mean(flat, model.rule.wt, axis=2)
-            cell_data[name] = _columns(through.reshape(len(mesh.cells), -1))
-            point_data[name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
-    if CONTACT_PRESSURE in fields:
-        point_data[CONTACT_PRESSURE] = _at_corners(contact_pressure(sim, mesh), model.conn, len(mesh.layers),
-                                                   CORNER_HATS)
-    if CONTACT_GAP in fields:
-        gaps = ToolForces(sim.model, []).gaps(sim.state.t, sim.state.fields.shape)
-        point_data[CONTACT_GAP] = _at_corners(gaps, model.conn, len(mesh.layers), CORNER_HATS)
-    if {PRINCIPAL, VESSEL} & set(fields):  # of each layer's stress in the solid view, of the mean in the shell view
-        cauchy = tensors[1] if mesh.solid else thickness_mean(tensors[1], model.rule.wt, axis=2)[:, :, None]
-        cell_data |= _stress_measures(sim, cauchy, model.rule.tz if mesh.solid else np.zeros(1), fields, vessel_axes,
-                                      mesh)
+            cell_data |= {name: _on_cells(array, mesh) for name, array in COMPUTE[kind.name](frame, None).items()}
     for face in () if mesh.solid else faces:  # the integration layer nearest the face
         k = 0 if face == "bottom" else len(model.rule.tz) - 1
         for name, flat in flats.items():
             cell_data[f"{name}_{face}"] = _columns(flat[:, :, k].reshape(len(mesh.cells), -1))
-        if {PRINCIPAL, VESSEL} & set(fields):
-            cell_data |= _stress_measures(sim, tensors[1][:, :, k:k + 1], model.rule.tz[k:k + 1], fields,
-                                          vessel_axes, mesh, f"_{face}")
-    if {FIBRES, FIBRE_STRETCH} & set(fields):  # every layer's in the solid view, the middle layer's in the shell view
-        nt = len(model.rule.tz)
-        for family, vectors in enumerate(fibre_vectors(sim, list(range(nt)) if mesh.solid else [nt // 2]), start=1):
-            stretch = np.linalg.norm(vectors, axis=-1)
-            if FIBRES in fields:
-                cell_data[f"{FIBRE_PREFIX}{family}"] = _on_cells(vectors / stretch[..., None], mesh)
-            if FIBRE_STRETCH in fields:
-                cell_data[f"{FIBRE_STRETCH}_{family}"] = _on_cells(stretch, mesh)
+        for kind in kinds:
+            if kind.lives == "cell" and kind.faces:
+                cell_data |= {f"{name}_{face}": _on_cells(array, mesh)
+                              for name, array in COMPUTE[kind.name](frame, k).items()}
     return point_data, cell_data

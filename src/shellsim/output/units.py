@@ -6,15 +6,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..deck.schema import SYSTEMS, UNIT_SIZES, WRITTEN_AS
+from ..deck.output_fields import FIELDS
+from ..deck.schema import SYSTEMS, UNIT_SIZES
 
 #: A field's smoothed nodal version: ``<field>_nodal``; its values nearest a face (output.faces).
 NODAL_SUFFIX, FACE_SUFFIXES = "_nodal", ("_bottom", "_top")
 #: What each field, written array or probe quantity measures.
-FIELD_KIND = {"displacement": "length", "position": "length", "thickness": "length", "stress": "stress",
-              "cauchy_stress": "stress", "lamina_stress": "stress", "pressure_band": "stress",
-              "von_mises": "stress", "contact_pressure": "stress", "contact_gap": "length", "time": "time",
-              **dict.fromkeys((*WRITTEN_AS["principal_stress"], *WRITTEN_AS["vessel_stress"]), "stress")}
+FIELD_KIND = {"position": "length", "stress": "stress", "time": "time",
+              **{name: kind.measures for kind in FIELDS if kind.measures
+                 for name in (kind.name, *kind.written_as)}}
 #: Kinds that are a power of another: (base kind, power).
 POWERS = {"area": ("length", 2), "volume": ("length", 3)}
 

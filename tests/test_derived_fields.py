@@ -1,6 +1,7 @@
 """The fields a tissue engineer plots first, derived from the stress and the fibres:
-principal stresses, the stresses in a vessel's axes and each fibre family's stretch,
-against closed forms, the probes and the algebra that ties them to the stress."""
+principal stresses, the stresses in a vessel's axes, each fibre family's stretch and the
+wall's through-thickness stretch, against closed forms, the probes and the algebra that
+ties them to the stress."""
 
 from __future__ import annotations
 
@@ -13,7 +14,7 @@ from shellsim.output.encoding import symmetric_tensors
 from shellsim.output.fields import frame_fields, output_mesh
 from shellsim.measures.probes import probe_value, resolve_probes
 
-from .conftest import ROOT, deck_text, prepared, problems_of, run_deck
+from .conftest import BASE, ROOT, deck_text, prepared, problems_of, run_deck
 
 TEST9 = ROOT / "decks" / "verification" / "test09_aorta_static.toml"
 DERIVED = ["cauchy_stress", "pressure_band", "principal_stress", "vessel_stress", "fibre_stretch"]
@@ -175,3 +176,41 @@ def test_material_axes_fields_ask_for_a_hyperelastic_material():
     assert ("'pk2_stress' is in the axes of a hyperelastic material (section.technique = 1), and material.model = "
             "'linear_elastic' with section.technique = None has none") in problems_of(
         plate + '\n[output]\nfields = ["pk2_stress"]\n')
+
+
+def test_an_incompressible_strip_pulled_to_a_stretch_thins_to_its_inverse_root():
+    """An incompressible neo-Hookean strip on rollers, its far edge pulled to a stretch
+    lambda = 1.5 (a static solve): uniaxial, so its through-thickness stretch,
+    ``thickness_stretch``, is lambda^(-1/2) at every point, while the unloaded strip's is 1."""
+    stretch = 1.5
+    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 0.5', f'''
+[mesh]
+divisions = {{ length = 2, width = 2 }}
+[[boundary]]
+type = "symmetry"
+set = "x0"
+normal = [1.0, 0.0, 0.0]
+[[boundary]]
+type = "symmetry"
+set = "y0"
+normal = [0.0, 1.0, 0.0]
+[[boundary]]
+type = "fixed"
+set = "all"
+translations = ["z"]
+[[boundary]]
+type = "prescribed"
+set = "x1"
+translation = "x"
+value = {stretch - 1.0}
+[output]
+fields = ["displacement", "thickness_stretch"]
+''', base=BASE.replace('model = "linear_elastic"\nE = 1000.0\nnu = 0.3', 'model = "neo_hookean"\nC1 = 100.0')
+        .replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0'))
+    run = prepared(parse_deck(text))
+    mesh = output_mesh(run.model)
+    np.testing.assert_allclose(frame_fields(run.sim, mesh, ["thickness_stretch"])[0]["thickness_stretch"], 1.0,
+                               rtol=1e-14)
+    run = run_deck(run.deck)
+    points = frame_fields(run.sim, mesh, ["thickness_stretch"])[0]["thickness_stretch"]
+    np.testing.assert_allclose(points, stretch**-0.5, rtol=1e-6)

@@ -61,6 +61,7 @@ FIELDS = (
     FieldKind("displacement", "length", "node"),
     FieldKind("director", None, "node"),
     FieldKind("thickness", "length", "node"),
+    FieldKind("thickness_stretch", None, "node"),  # the fibre's length over its initial one: the wall's lambda_3
     FieldKind("cauchy_stress", "stress", "point"),
     FieldKind("lamina_stress", "stress", "point"),
     FieldKind("pressure_band", "stress", "point"),

@@ -300,6 +300,7 @@ COMPUTE = {
     "displacement": _displacement,
     "director": _director,
     "thickness": lambda frame: frame.on_corners(frame.sim.state.h),
+    "thickness_stretch": lambda frame: frame.on_corners(frame.sim.state.h / frame.sim.model.h0),
     "cauchy_stress": lambda frame: frame.tensors[1],
     "lamina_stress": lambda frame: frame.tensors[0],
     "pressure_band": lambda frame: pressure_band(frame.tensors[1]),

@@ -130,3 +130,25 @@ def test_an_abaqus_model_comes_back_whole(tmp_path):
                 r"output requests \(\*OUTPUT, first at valve_patch\.inp:\d+\)"]
     assert all(any(re.search(pattern, line) for line in model.unmapped) for pattern in expected), model.unmapped
     assert len(model.unmapped) == len(expected), model.unmapped
+
+
+@pytest.mark.parametrize("data, law", [
+    # three terms of one exponent, as Abaqus writes a one-term fit, the D_i on a second line
+    (["0.1, 12., 0.2, 12., 0.05, 12., 0., 0.", "0."], {"model": "ogden", "mu": [0.1, 0.2, 0.05],
+                                                      "alpha": [12.0, 12.0, 12.0]}),
+    # two distinct terms and a third of negative exponent
+    (["0.1, 12., 0.02, 4., -0.01, -2., 0., 0.", "0."], {"model": "ogden", "mu": [0.1, 0.02, -0.01],
+                                                       "alpha": [12.0, 4.0, -2.0]}),
+])
+def test_the_chords_ogden_law_of_three_terms_comes_over_term_by_term(tmp_path, data, law):
+    """A chord's ``*HYPERELASTIC, OGDEN, N=3`` becomes its cable's Ogden law with the three
+    terms in order (nothing listed about the chords), which the deck accepts."""
+    from shellsim.loads.cable_laws import Ogden
+
+    path = tmp_path / "valve_patch.inp"
+    path.write_text(abaqus_model().replace("*Hyperelastic, ogden, n=1\n0.5, 12., 0.\n",
+                                           "*Hyperelastic, ogden, n=3\n" + "\n".join(data) + "\n"))
+    model = read_foreign(path)
+    assert [c["law"] for c in model.tables["cable"]] == [law, law]
+    assert not [line for line in model.unmapped if "Chorda" in line or "1D law" in line]
+    Ogden(**law)

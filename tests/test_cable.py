@@ -51,6 +51,10 @@ LAWS = {
     "neo_hookean": ('{ model = "neo_hookean", mu = 1.0e6 }', lambda s: 1.0e6 * (s - s ** -2), 250.0),
     "ogden": ('{ model = "ogden", mu = 1.0e6, alpha = 5.0 }',
               lambda s: 2.0e6 / 5.0 * (s ** 4 - s ** -3.5), 250.0),
+    # three terms as Abaqus writes them, one of negative exponent (mu alpha > 0)
+    "ogden_three_terms": ('{ model = "ogden", mu = [2.0e5, 5.0e4, -1.0e5], alpha = [8.0, 3.0, -2.0] }',
+                          lambda s: sum(2.0 * m / a * (s ** (a - 1.0) - s ** (-a / 2.0 - 1.0))
+                                        for m, a in ((2.0e5, 8.0), (5.0e4, 3.0), (-1.0e5, -2.0))), 250.0),
     "exponential": ('{ model = "exponential", a = 1.0e5, b = 0.5 }',
                     lambda s: 1.0e5 * math.exp(0.5 * (s * s + 2.0 / s - 3.0)) * (s - s ** -2), 250.0),
 }
@@ -62,7 +66,8 @@ def test_a_pulled_cable_stretches_as_its_law_says_to_large_stretch(name):
     across it: a string at rest has no lateral stiffness), solved statically: the tip's
     stretch solves A P(lambda) = F for the law written out above (closed form for the
     linear law, a scalar root otherwise), to 0.1%. The forces take the cable to stretches
-    of 2.5 (linear), 2.64 (neo-Hooke), 1.59 (Ogden, alpha 5) and 2.62 (exponential)."""
+    of 2.5 (linear), 2.64 (neo-Hooke), 1.59 (Ogden, alpha 5), 1.48 (three Ogden terms) and
+    2.62 (exponential)."""
     from shellsim.deck import parse_deck
 
     law, stress, force = LAWS[name]
@@ -82,6 +87,39 @@ translations = ["y", "z"]
     expected = brentq(lambda s: AREA * stress(s) - force, 1.0 + 1e-12, 10.0)
     assert expected > 1.5
     assert stretch == pytest.approx(expected, rel=1e-3)
+
+
+def test_an_ogden_law_s_terms_of_one_exponent_act_as_one_and_its_slope_is_its_derivative():
+    """Abaqus writes a one-term Ogden chord as three terms of one exponent: the law merges
+    them, its stress then that of the one term of their summed mu to the last bit, while
+    a law of distinct terms meets the sum written out here to 1e-13 from lambda = 1 to 3
+    and its slope the stress's central difference to 1e-7; each term must stiffen in
+    tension (mu alpha > 0), and six terms at most."""
+    from shellsim.loads.cable_laws import Ogden, code_and_parameters, nominal_stress
+
+    def law(mu, alpha):
+        return code_and_parameters(Ogden(model="ogden", mu=mu, alpha=alpha))
+
+    stretches = np.linspace(1.0, 3.0, 41)
+    (c3, p3), (c1, p1) = law([0.1, 0.2, 0.3], [12.0, 12.0, 12.0]), law(0.1 + 0.2 + 0.3, 12.0)
+    assert [nominal_stress(c3, p3, s) for s in stretches] == [nominal_stress(c1, p1, s) for s in stretches]
+    terms = ((2.0e5, 8.0), (5.0e4, 3.0), (-1.0e5, -2.0))
+    code, params = law([m for m, _ in terms], [a for _, a in terms])
+    for s in stretches:
+        p, dp = nominal_stress(code, params, s)
+        assert p == pytest.approx(sum(2 * m / a * (s ** (a - 1) - s ** (-a / 2 - 1)) for m, a in terms), rel=1e-13,
+                                  abs=1e-9)
+        if s > 1.0:
+            step = 1e-6 * s
+            difference = (nominal_stress(code, params, s + step)[0] - nominal_stress(code, params, s - step)[0]) / (2 * step)
+            assert dp == pytest.approx(difference, rel=1e-7)
+    chord = '{{ model = "ogden", mu = {}, alpha = {} }}'
+    assert "term 2: mu = -1, alpha = 3; each term needs mu * alpha > 0" in problems_of(
+        deck_text(PLATE, ANCHOR + cable_table(chord.format("[1.0, -1.0]", "[2.0, 3.0]"), (2.0, 0.5, 0.0))))
+    assert "1 to 6 terms" in problems_of(
+        deck_text(PLATE, ANCHOR + cable_table(chord.format([1.0] * 7, [2.0] * 7), (2.0, 0.5, 0.0))))
+    assert "1 to 6 terms" in problems_of(
+        deck_text(PLATE, ANCHOR + cable_table(chord.format("[1.0, 1.0]", "[2.0]"), (2.0, 0.5, 0.0))))
 
 
 def test_a_pushed_cable_carries_no_compression():

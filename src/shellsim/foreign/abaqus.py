@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import MeshError
+from ..loads.cable_laws import OGDEN_TERMS
 from . import ForeignModel, meta_table
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
 from .deck_tables import AXES, pressure_loads, support_table
@@ -236,7 +237,8 @@ class _Builder:
         law = self._cable_law(by_name)
         if law is None:
             m.unmapped.append(f"{material.label()}: material '{material.param('name')}' of the cables of '{lines}' has "
-                              "no 1D law shellsim maps (*ELASTIC, *HYPERELASTIC NEO HOOKE or OGDEN N=1); they are "
+                              "no 1D law shellsim maps (*ELASTIC, *HYPERELASTIC NEO HOOKE or OGDEN of N <= 6 terms "
+                              "each with mu alpha > 0); they are "
                               "left out")
             return None
         density = by_name.get("density")
@@ -254,12 +256,30 @@ class _Builder:
             row = [float(v) for v in k.rows[0]] if k.rows else []
             if "neo hooke" in k.params and row:
                 return {"model": "neo_hookean", "mu": 2.0 * row[0]}
-            if "ogden" in k.params and int(k.param("n") or 1) == 1 and len(row) >= 2:
-                return {"model": "ogden", "mu": row[0], "alpha": row[1]}
+            if "ogden" in k.params:
+                return _Builder._ogden(k)
             return None
         if "elastic" in by_name and by_name["elastic"].rows:
             return {"model": "linear", "E": float(by_name["elastic"].rows[0][0])}
         return None
+
+    @staticmethod
+    def _ogden(k: Keyword) -> dict | None:
+        """An ``*HYPERELASTIC, OGDEN, N=n`` law (n <= 6): its data lines hold mu_1, alpha_1,
+        ..., mu_n, alpha_n, then the compressibilities D_i (an incompressible chord takes
+        none); None where it does not fit :class:`~shellsim.loads.cable_laws.Ogden`."""
+        try:
+            terms = int(k.param("n") or 1)
+            values = [float(v) for row in k.rows for v in row if str(v).strip()]
+        except ValueError:
+            return None
+        if not 1 <= terms <= OGDEN_TERMS or len(values) < 2 * terms:
+            return None
+        mu, alpha = values[0:2 * terms:2], values[1:2 * terms:2]
+        if not all(m * a > 0.0 for m, a in zip(mu, alpha)):
+            return None
+        return {"model": "ogden", "mu": mu[0], "alpha": alpha[0]} if terms == 1 else {"model": "ogden", "mu": mu,
+                                                                                        "alpha": alpha}
 
     def _step_params(self) -> dict[str, str]:
         step = self.model.steps[0][0].params if self.model.steps else {}

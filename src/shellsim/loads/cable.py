@@ -158,7 +158,7 @@ def extend_mesh(table: Cable, mesh: Mesh) -> Mesh:
 class Bundle(NamedTuple):
     """Cable elements (L): nodes (L, 2) their ends; rest (L,) rest lengths [length];
     area (L,) initial cross-sections [length^2]; density (L,) [mass/length^3]; law (L,)
-    and params (L, 3) of :mod:`.cable_laws`; gravity (L, 3) [length/time^2]."""
+    and params (L, PARAMETERS) of :mod:`.cable_laws`; gravity (L, 3) [length/time^2]."""
 
     nodes: np.ndarray
     rest: np.ndarray

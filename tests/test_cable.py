@@ -206,6 +206,24 @@ def test_a_hanging_cable_takes_the_exact_elastic_catenary():
     assert coarse[1] < coarse[0] and fine[1] < fine[0]
 
 
+def test_mass_scaling_takes_the_cables_step_to_its_target_with_the_shell_s():
+    """The hanging cable in 32 segments: its elements' own critical step bounds the
+    scene's. Mass scaling multiplies every mass, the cables' too, by (target / step)^2, so
+    their own step grows with the rest and the step becomes the target, as in a scene
+    without cables (it stayed at the cables' unscaled step)."""
+    from shellsim.deck import parse_deck
+
+    def deck(end: str) -> str:
+        return hanging_cable_deck(32).replace("end_time = 6.0", f"end_time = {end}")
+
+    plain = run_deck(parse_deck(deck("1e-3")))
+    first = plain.dt_history[0][2]
+    target = 4.0 * float(first)
+    scaled = run_deck(parse_deck(deck(f"4e-3\nmass_scaling = {{ step = {target!r} }}")))
+    assert scaled.sim.mass_factor == pytest.approx(16.0, rel=1e-12)
+    assert scaled.dt_history[1][2] == pytest.approx(target, rel=1e-3)  # to the estimate's tolerance (it was 8% short)
+
+
 def test_the_cable_tangent_is_the_derivative_of_its_forces():
     """The couplings' blocks of a stretched, turned cable against central differences of
     its forces (the exact tangent, to the differences' truncation)."""

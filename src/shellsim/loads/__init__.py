@@ -171,11 +171,12 @@ def step_share(model) -> float:
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)
 
 
-def stable_step(model, shape: Shape, structure: float) -> float:
+def stable_step(model, shape: Shape, structure: float, mass_factor: float = 1.0) -> float:
     """The critical step of the whole scene on ``shape``, from the shell structure's
     ``structure``: that share of it the penalties leave stable, and no longer than the
-    step of any load kind's own elements (cables)."""
-    own = [kind.critical_step(shape, bundle) for kind, bundle in _with(model, "critical_step")]
+    step of any load kind's own elements (cables), whose masses mass scaling multiplies
+    by ``mass_factor`` with the shell's (their step by its square root)."""
+    own = [kind.critical_step(shape, bundle) * np.sqrt(mass_factor) for kind, bundle in _with(model, "critical_step")]
     return min([structure * step_share(model)] + own)
 
 

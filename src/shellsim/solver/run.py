@@ -261,7 +261,8 @@ def _watch_quality(run: Run) -> None:
 def _update_time_step(run: Run, listener: Listener) -> None:
     _watch_quality(run)
     run.sim.update_masses()
-    run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, run.sim.critical_time_step())
+    run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, run.sim.critical_time_step(),
+                                  run.sim.mass_factor)
     run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
     listener.on_dt(run)

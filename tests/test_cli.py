@@ -28,6 +28,18 @@ def test_check_summarises_a_valid_deck():
         assert fragment in result.output
 
 
+def test_check_forecasts_a_mass_scaled_run_at_its_target_step():
+    """The mass-scaled cantilever (Test 2) takes steps of its target 1.2e-5 to t = 0.12:
+    `check` says how much every mass grows and counts the steps of the target (10,000),
+    not of the unscaled critical step (four times as many)."""
+    result = runner.invoke(app, ["check", str(ROOT / "decks" / "verification"
+                                              / "test02_cantilever_uniform_load_3_mass_scaled.toml")])
+    said = " ".join(result.output.replace("│", " ").split())  # the table's cells, wrapped, as one text
+    assert result.exit_code == 0, result.output
+    assert "for the mass scaling's step 1.2e-05: about 10,000 steps to the end" in said
+    assert "every mass x 1" in said
+
+
 def test_check_of_a_broken_deck_prints_the_problem_without_a_traceback(tmp_path):
     deck = tmp_path / "broken.toml"
     deck.write_text(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0').replace("nu = 0.3", "nu = 0.6"))

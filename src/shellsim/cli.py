@@ -599,7 +599,10 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                 f"(TSSFAC {1 / sv.dt_safety_factor:.3g}), mass {sv.mass}"
                                 + (f", damping {sv.damping}/s" if sv.damping else ""))
         row("time step", f"critical {outlook[sv.mass]:.4g} at t = 0 (M1 {outlook['M1']:.4g}, "
-                                   f"M2 {outlook['M2']:.4g}): about {outlook['steps']:,} steps to the end at that "
+                                   f"M2 {outlook['M2']:.4g})"
+                                   + (f"; every mass x {outlook['mass_factor']:.4g} for the mass scaling's step "
+                                      f"{outlook['dt']:.4g}" if outlook["mass_factor"] > 1.0 else "")
+                                   + f": about {outlook['steps']:,} steps to the end at that "
                                    "step (it falls as elements crumple or stiffen, and the steps and cost grow "
                                    "with it; the run's progress shows the step as it goes)")
         row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "

@@ -50,16 +50,20 @@ def time_step(solver: Solver, dt_critical: float) -> float:
 
 def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What the run's time step will be, before it starts: the critical step at t = 0
-    [time] with each lumping, ``{"M1": .., "M2": ..}``; ``steps``, the number of steps to
-    the end time with the deck's lumping and safety factor at that step (a stiffening
-    scene takes more); ``seconds``, about how long they take, and ``bytes``, the memory the
+    [time] with each lumping, ``{"M1": .., "M2": ..}``; ``dt``, the step the run takes
+    first, with the deck's lumping and safety factor, or the mass scaling's target and
+    ``mass_factor`` the masses' factor that reaches it (1 without); ``steps``, the number
+    of steps of ``dt`` to the end time (a stiffening scene takes more); ``seconds``, about how long they take, and ``bytes``, the memory the
     run holds. ``on_product(count)`` is told each stiffness product of the estimates."""
     initial = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
     critical = {mass: stable_step(model, initial, Simulation(model._replace(mass=mass)).critical_time_step(on_product))
                 for mass in ("M1", "M2")}
     dt = time_step(deck.solver, critical[deck.solver.mass])
+    scaling, mass_factor = deck.solver.mass_scaling, 1.0
+    if scaling is not None and dt < scaling.step:  # every mass scaled, the step the target
+        mass_factor, dt = (scaling.step / dt) ** 2, scaling.step
     steps, seconds = stepping(deck.solver.end_time, dt, model.n_elements)
-    return critical | {"dt": dt, "steps": math.ceil(steps), "seconds": seconds,
+    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": math.ceil(steps), "seconds": seconds,
                        "bytes": memory_bytes(model.n_elements)}
 
 

@@ -13,7 +13,7 @@ from shellsim.bundles import Material
 from shellsim.element.steps import HYPERELASTIC
 from shellsim.lanes import LANES
 from shellsim.materials import zero_normal_stress as zns
-from shellsim.materials.laws import LAWS, held_law, law_of
+from shellsim.materials.laws import LAWS, held_laws, law_of
 
 PARAMETERS = {
     "mooney_rivlin": np.array([0.2e6, 0.05e6]),
@@ -33,11 +33,11 @@ def material(case: str) -> Material:
     """The kernels' bundle for the law serving the model of ``case`` with its
     :data:`PARAMETERS`."""
     code, law = law_of(MODEL_OF.get(case, case))
-    energy_stress, energy_tangent = held_law(code)
-    return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=False, law=code,
-                    energy_stress=energy_stress, energy_tangent=energy_tangent, params=PARAMETERS[case],
-                    incompressible=law.INCOMPRESSIBLE, axes0=np.zeros((1, 1, 1, 3, 3)), C=np.zeros((5, 5)),
-                    normal_ratio=0.0)
+    energy_stress, energy_tangent = held_laws([code])
+    return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=False,
+                    law=np.array([code]), energy_stress=energy_stress, energy_tangent=energy_tangent,
+                    params=PARAMETERS[case][None], incompressible=np.array([law.INCOMPRESSIBLE]),
+                    axes0=np.zeros((1, 1, 1, 3, 3)), C=np.zeros((1, 5, 5)), normal_ratio=np.zeros(1))
 
 
 def random_strains(rng, size):
@@ -58,7 +58,7 @@ def solved_stress(mat, E):
     """(S~, E with E33 solved, Cinv, pressure) of strains E (3, 3, G)."""
     E = E.copy()
     S, Cinv, pressure, volume, work = lane_values()
-    zns.stress(mat, E, S, Cinv, pressure, volume, work)
+    zns.stress(mat, 0, E, S, Cinv, pressure, volume, work)
     return S, E, Cinv, pressure
 
 
@@ -66,8 +66,8 @@ def reduced_energy(mat, E):
     """W~ (G,) of the eight in-plane and shear components, E33 from zero normal stress."""
     E = E.copy()
     stretch, W = np.empty(LANES), np.empty(LANES)
-    zns.normal_strain(mat, E, stretch, np.empty((3, 3, 3, LANES)))
-    LAWS[mat.law].energy(mat.params, E, W)
+    zns.normal_strain(mat, 0, E, stretch, np.empty((3, 3, 3, LANES)))
+    LAWS[mat.law[0]].energy(mat.params[0], E, W)
     return W
 
 
@@ -100,7 +100,7 @@ def test_tangent_is_the_derivative_of_the_stress(model):
         direction = random_strains(rng, 0.5)
         S, E_solved, Cinv, pressure = solved_stress(mat, E)
         dS = np.empty((3, 3, LANES))
-        zns.tangent(mat, E_solved, Cinv, pressure, direction.copy(), dS, np.empty((3, 3, 3, LANES)))
+        zns.tangent(mat, 0, E_solved, Cinv, pressure, direction.copy(), dS, np.empty((3, 3, 3, LANES)))
         h = 1e-6
         Sp, Sm = solved_stress(mat, E + h * direction)[0], solved_stress(mat, E - h * direction)[0]
         np.testing.assert_allclose(dS, (Sp - Sm) / (2 * h), rtol=1e-5, atol=1e-6 * np.abs(dS).max())
@@ -122,7 +122,7 @@ def test_st_venant_kirchhoff_normal_strain_frees_the_normal_stress():
     E = random_strains(np.random.default_rng(4), 0.3)
     S, Cinv, pressure, volume, work = lane_values()
     solved = E.copy()
-    zns.stress(mat, solved, S, Cinv, pressure, volume, work)
+    zns.stress(mat, 0, solved, S, Cinv, pressure, volume, work)
     np.testing.assert_allclose(solved[2, 2], -lam * (E[0, 0] + E[1, 1]) / (lam + 2 * mu), rtol=1e-14)
     np.testing.assert_allclose(volume, np.sqrt(np.linalg.det(2 * solved.transpose(2, 0, 1) + np.eye(3))), rtol=1e-14)
     assert np.all(pressure == 0.0)

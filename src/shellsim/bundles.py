@@ -47,46 +47,57 @@ class Body(NamedTuple):
     fibre lengths [length]; node_slots (n + 1,) and slots (ne * 9,): for each node, the
     element slots e * 9 + a that hold it, in ascending order (node k's are
     slots[node_slots[k]:node_slots[k + 1]]), so nodal sums of element values are taken
-    in one fixed order whatever the number of threads."""
+    in one fixed order whatever the number of threads. part (ne,): each element's part
+    (its material, an index into :class:`Material`'s per-part fields); the element loops'
+    groups hold one part each: group g holds elements group_order[group_start[g]:
+    group_start[g + 1]] (at most LANES) of part group_part[g]; density (ne,) [mass/length^3]."""
 
     conn: np.ndarray
     jac0_inv: np.ndarray
     h0: np.ndarray
     node_slots: np.ndarray
     slots: np.ndarray
+    part: np.ndarray
+    group_start: np.ndarray
+    group_order: np.ndarray
+    group_part: np.ndarray
+    density: np.ndarray
 
 
 class Material(NamedTuple):
-    """The constitutive path, decided once when the model is built.
+    """The constitutive path, decided once when the model is built, shared by the model's
+    parts, and each part's law and constants (M parts: its fields by part).
 
     path: SMALL_STRAIN, HYPERELASTIC (Technique 1) or CONVECTED (Techniques 2 and 3) of
     :mod:`shellsim.element.steps` (thesis 3.10); incremental: stress accumulated from
     strain increments (thesis Eq 3.2) instead of computed from the total strain (small
     strain by choice, convected always); push_forward: Technique 2's stretch of the
     accumulated stresses; thickness_update: the fibre lengths follow the normal stretch
-    (thesis 3.11). law: the code of a hyperelastic law (:mod:`shellsim.materials.laws`);
-    energy_stress, energy_tangent: its S^w and CC^w : dE, each held for calls through its
-    address, ``material.energy_stress[0](params, E, S)``
-    (:func:`~shellsim.materials.laws.held_law`; the first law's, never called, on the
-    other paths); params (P,): its parameters; incompressible: whether it keeps J = 1; axes0
-    (ne, nq, nt, 3, 3) its initial material frames (rows a1, a2, a3; (1, ...) unused
-    otherwise). C (5, 5): reduced lamina matrix of the constant tensor [stress] (the other
-    paths); normal_ratio: nu / (1 - nu), the normal strain increment per in-plane one of
-    the convected path.
+    (thesis 3.11). law (M,): each part's hyperelastic law's code
+    (:mod:`shellsim.materials.laws`); energy_stress, energy_tangent: each part's S^w and
+    CC^w : dE, held for calls through their addresses,
+    ``material.energy_stress[part](params[part], E, S)``
+    (:func:`~shellsim.materials.laws.held_laws`; the first law's, never called, on the
+    other paths); params (M, P): each part's parameters (padded with zeros); incompressible
+    (M,): whether the part's law keeps J = 1; axes0 (ne, nq, nt, 3, 3) the elements' initial
+    material frames (rows a1, a2, a3; (1, ...) unused otherwise). C (M, 5, 5): each part's
+    reduced lamina matrix of the constant tensor [stress] (the other paths); normal_ratio
+    (M,): nu / (1 - nu), the normal strain increment per in-plane one of the convected
+    path.
     """
 
     path: int
     incremental: bool
     push_forward: bool
     thickness_update: bool
-    law: int
+    law: np.ndarray
     energy_stress: List
     energy_tangent: List
     params: np.ndarray
-    incompressible: bool
+    incompressible: np.ndarray
     axes0: np.ndarray
     C: np.ndarray
-    normal_ratio: float
+    normal_ratio: np.ndarray
 
 
 class Curves(NamedTuple):
@@ -123,7 +134,7 @@ class Model(NamedTuple):
     """A scene as the compiled layer sees it (:func:`shellsim.model.build_model`): its
     rule, mesh, material, loads, curves and supports, and the initial shape (n nodes):
     x0, d0 (n, 3) mid-surface and directors, e1f0 (n, 3) fibre-frame first axes;
-    density [mass/length^3]; mass 'M1' or 'M2' (thesis 3.14); damping [1/s]
+    mass 'M1' or 'M2' (thesis 3.14); damping [1/s]
     (mass-proportional); kinetic_damping: every velocity set to zero at each peak of the
     kinetic energy (dynamic relaxation)."""
 
@@ -136,7 +147,6 @@ class Model(NamedTuple):
     x0: np.ndarray
     d0: np.ndarray
     e1f0: np.ndarray
-    density: float
     mass: str
     damping: float
     kinetic_damping: bool

@@ -564,9 +564,9 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
     cables = f", {len(built.lines)} cable elements" if len(built.lines) else ""
     row("mesh", f"{built.n_elements} elements ({divisions or 'from file'}){cables}, "
                           f"{built.n_nodes} nodes, {5 * built.n_nodes} DOFs")
-    m = scene.material
-    params = ", ".join(f"{k}={v}" for k, v in m.model_dump().items() if k not in ("model", "axes"))
-    row("material", f"{m.model} ({params})")
+    for m in scene.material:
+        params = ", ".join(f"{k}={v}" for k, v in m.model_dump().items() if k not in ("model", "axes", "sets"))
+        row("material", f"{m.model} ({params})" + (f" on {', '.join(repr(s) for s in m.sets)}" if m.sets else ""))
     s = scene.section
     strain = f"technique {s.technique}" if s.technique else "small strain"
     row("section", f"thickness {s.thickness}, {s.points_through_thickness} points through "

@@ -48,6 +48,13 @@ def hold_instead(held: List, dispatcher, signature) -> None:
     _entry_point(_put, (typeof(held), types.FunctionType(signature)))(held, dispatcher)
 
 
+def hold_also(held: List, dispatcher, signature) -> None:
+    """Append ``dispatcher``, compiled for ``signature``, to the holder ``held``
+    (:func:`held_by_address`, the same signature): callers call it as ``f[1](...)``,
+    ``f[2](...)``, ... in the order held."""
+    _entry_point(_append, (typeof(held), types.FunctionType(signature)))(held, dispatcher)
+
+
 def _entry_point(dispatcher, argument_types):
     """The code of ``dispatcher`` compiled for exactly ``argument_types`` (or loaded from
     the cache), called without numba's typing: a function handed over as the function type
@@ -66,3 +73,8 @@ def _hold(function):
 @njit(cache=True)
 def _put(held, function):
     held[0] = function
+
+
+@njit(cache=True)
+def _append(held, function):
+    held.append(function)

@@ -20,7 +20,8 @@ from .element.frames import initial_fibre_frame
 from .element.steps import CONVECTED, HYPERELASTIC, SMALL_STRAIN
 from .element.shape import NODE_RS, gauss_rule, gauss_rule_2d, shape, shape_derivatives
 from .loads import DECK_KEYS, LoadScene, build_loads
-from .materials.laws import held_law, law_of
+from .element.groups import part_groups
+from .materials.laws import held_laws, law_of
 from .materials.linear import reduced_lamina_matrix
 from .mesh import Mesh, inverse_jacobians, layer_geometry
 
@@ -81,8 +82,12 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     rule = integration_rule(deck.section.points_through_thickness, deck.section.plane_strain)
     conn = mesh.conn.astype(np.int64)
     node_slots, slots = slots_by_node(conn, mesh.n_nodes)
+    part = element_parts(deck, mesh)
+    group_start, group_order, group_part = part_groups(part)
     body = Body(conn=conn, jac0_inv=inverse_jacobians(mesh, rule.N, rule.dNr, rule.dNs, rule.tz),
-                h0=mesh.thickness.copy(), node_slots=node_slots, slots=slots)
+                h0=mesh.thickness.copy(), node_slots=node_slots, slots=slots, part=part, group_start=group_start,
+                group_order=group_order, group_part=group_part,
+                density=np.array([m.density for m in deck.material])[part])
     constraints, e1f0 = _boundary_conditions(deck, mesh)
     curves = _curve_tables(deck)
     initial = Shape(x=mesh.x, d=mesh.director, e1=e1f0, h=mesh.thickness)
@@ -90,58 +95,90 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
                         LoadScene(mesh=mesh, rule=rule, body=body, initial=initial, curves=curves,
                                   curve_index=deck.curve_index))
     return Model(
-        rule=rule, body=body, material=_material(deck, mesh, rule), loads=loads, curves=curves,
-        constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0,
-        density=deck.material.density, mass=deck.solver.mass, damping=deck.solver.damping,
+        rule=rule, body=body, material=_material(deck, mesh, rule, part), loads=loads, curves=curves,
+        constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0, mass=deck.solver.mass, damping=deck.solver.damping,
         kinetic_damping=deck.solver.relaxation is not None,
     )
 
 
-def _material(deck: Deck, mesh: Mesh, rule: Rule) -> Material:
-    """The kernels' :class:`~shellsim.bundles.Material` (the deck has refused the paths
-    the element cannot run).
+def element_parts(deck: Deck, mesh: Mesh) -> np.ndarray:
+    """(ne,) each element's material, its place in ``deck.material``: all the first's for
+    a deck of one material without sets, else the one whose sets hold it. Raises
+    MeshError naming the elements no material covers, or two do."""
+    if len(deck.material) == 1 and not deck.material[0].sets:
+        return np.zeros(mesh.n_elements, dtype=np.int64)
+    covers = np.zeros((len(deck.material), mesh.n_elements), dtype=bool)
+    for i, material in enumerate(deck.material):
+        for name in material.sets:
+            covers[i, mesh.sets[name].elements] = True
+    centres = mesh.x[mesh.conn[:, 8]]
+    for elements, what in ((np.flatnonzero(covers.sum(axis=0) == 0), "in no material's sets"),
+                           (np.flatnonzero(covers.sum(axis=0) > 1), "in the sets of several materials")):
+        if len(elements):
+            owners = sorted({i for e in elements for i in np.flatnonzero(covers[:, e])})
+            raise MeshError(f"{len(elements)} element(s) are {what}"
+                            + (f" ({', '.join(f'material[{i}]' for i in owners)})" if owners else "")
+                            + f": elements {id_list(elements + 1)} (the first at {place(centres[elements[0]])}); "
+                            "every element has exactly one material")
+    return np.argmax(covers, axis=0).astype(np.int64)
+
+
+def _material(deck: Deck, mesh: Mesh, rule: Rule, part: np.ndarray) -> Material:
+    """The kernels' :class:`~shellsim.bundles.Material`, each of its per-part fields one
+    row per deck material (the deck has refused the paths the element cannot run, and
+    parts of different paths).
 
     A linear elastic material without a technique is the small-strain path, with
     Technique 1 it is St. Venant-Kirchhoff; a hyperelastic one runs Technique 1 (total
     formulation, zero normal stress by J = 1). Technique 1 needs the material frames at
-    the Gauss points of the initial shape.
+    the Gauss points of the initial shape, each element's from its material's axes.
     """
-    material, section = deck.material, deck.section
-    nq = len(rule.wq)
-    no_axes = np.zeros((1, nq, len(rule.tz), 3, 3))  # the kernels index it only for Technique 1
-    constant = dict(push_forward=False, law=0, params=np.zeros(1), incompressible=False, axes0=no_axes,
-                    normal_ratio=0.0)
-    if section.technique in (None, 2, 3):  # no law: the first law's functions, held and never called
-        constant |= dict(zip(("energy_stress", "energy_tangent"), held_law(0), strict=True))
-    if section.technique is None:
-        return Material(path=SMALL_STRAIN, incremental=section.formulation == "incremental", thickness_update=False,
-                        C=reduced_lamina_matrix(material.E, material.nu, section.plane_strain), **constant)
-    if section.technique in (2, 3):
-        # constant tensor, stresses accumulated in the lamina frame from each step's
-        # strain increment; the normal increment -nu/(1 - nu) (e11 + e22) scales h
-        return Material(path=CONVECTED, incremental=True, thickness_update=deck.thickness_update,
-                        C=reduced_lamina_matrix(material.E, material.nu),
-                        **(constant | {"push_forward": section.technique == 2,
-                                       "normal_ratio": material.nu / (1.0 - material.nu)}))
-    code, law = law_of(material.model)
-    axes0 = material_frames(mesh, getattr(material, "axes", None), rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz)
-    energy_stress, energy_tangent = held_law(code)
+    materials, section = deck.material, deck.section
+    nq, count = len(rule.wq), len(deck.material)
+    path = {None: SMALL_STRAIN, 1: HYPERELASTIC}.get(section.technique, CONVECTED)
+    if path != HYPERELASTIC:  # no law: the first law's functions, held and never called
+        energy_stress, energy_tangent = held_laws([0])
+        plane_strain = section.plane_strain and path == SMALL_STRAIN
+        return Material(
+            path=path, incremental=path == CONVECTED or section.formulation == "incremental",
+            push_forward=section.technique == 2, thickness_update=path == CONVECTED and deck.thickness_update,
+            law=np.zeros(count, dtype=np.int64), energy_stress=energy_stress, energy_tangent=energy_tangent,
+            params=np.zeros((count, 1)), incompressible=np.zeros(count, dtype=bool),
+            axes0=np.zeros((1, nq, len(rule.tz), 3, 3)),  # the kernels index it only for Technique 1
+            C=np.array([reduced_lamina_matrix(m.E, m.nu, plane_strain) for m in materials]),
+            normal_ratio=np.array([m.nu / (1.0 - m.nu) if path == CONVECTED else 0.0 for m in materials]))
+    laws = [law_of(m.model) for m in materials]
+    params = [law.parameters(m) for m, (_, law) in zip(materials, laws)]
+    padded = np.zeros((count, max(len(p) for p in params)))
+    for i, p in enumerate(params):
+        padded[i, :len(p)] = p
+    axes0 = np.empty((mesh.n_elements, nq, len(rule.tz), 3, 3))
+    for i, m in enumerate(materials):
+        elements = np.flatnonzero(part == i)
+        axes0[elements] = material_frames(mesh, getattr(m, "axes", None), rule.N[:nq], rule.dNr[:nq],
+                                          rule.dNs[:nq], rule.tz, elements)
+    energy_stress, energy_tangent = held_laws([code for code, _ in laws])
     return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=deck.thickness_update,
-                    law=code, energy_stress=energy_stress, energy_tangent=energy_tangent, params=law.parameters(material),
-                    incompressible=law.INCOMPRESSIBLE, axes0=axes0, C=np.zeros((5, 5)), normal_ratio=0.0)
+                    law=np.array([code for code, _ in laws], dtype=np.int64), energy_stress=energy_stress,
+                    energy_tangent=energy_tangent, params=padded,
+                    incompressible=np.array([law.INCOMPRESSIBLE for _, law in laws]), axes0=axes0,
+                    C=np.zeros((count, 5, 5)), normal_ratio=np.zeros(count))
 
 
-def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz) -> np.ndarray:
-    """(ne, nq, nt, 3, 3) initial material frames at the Gauss points, rows (a1, a2, a3):
-    :func:`lamina_axes` of the axes' preferred direction (:class:`shellsim.materials.axes.TurnedAxes`;
-    g_r for an isotropic law), a1 then turned about a3 by the layer's ``axes.angle_deg``."""
-    out = np.empty((mesh.n_elements, len(N), len(tz), 3, 3))
+def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz, elements: np.ndarray | None = None) -> np.ndarray:
+    """(m, nq, nt, 3, 3) initial material frames at the Gauss points of the ``elements``
+    (m,) (all by default), rows (a1, a2, a3): :func:`lamina_axes` of the axes' preferred
+    direction (:class:`shellsim.materials.axes.TurnedAxes`; g_r for an isotropic law), a1
+    then turned about a3 by the layer's ``axes.angle_deg``."""
+    elements = np.arange(mesh.n_elements) if elements is None else elements
+    conn, cell_vectors = mesh.conn[elements], {name: v[elements] for name, v in mesh.cell_vectors.items()}
+    out = np.empty((len(elements), len(N), len(tz), 3, 3))
     turns = np.zeros(len(tz)) if axes is None else axes.angles(tz)
     for k, t in enumerate(tz):
-        position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, mesh.conn, N, dNr, dNs, t)
-        preferred = jac[..., 0] if axes is None else axes.preferred(position, mesh.cell_vectors)
+        position, jac = layer_geometry(mesh.x, mesh.director, mesh.thickness, conn, N, dNr, dNs, t)
+        preferred = jac[..., 0] if axes is None else axes.preferred(position, cell_vectors)
         if axes is not None:
-            _refuse_along_normal(axes, jac, preferred, mesh.x[mesh.conn[:, 8]])
+            _refuse_along_normal(axes, jac, preferred, mesh.x[conn[:, 8]])
         frames = lamina_axes(jac, preferred)
         a1 = np.cos(turns[k]) * frames[..., 0, :] + np.sin(turns[k]) * frames[..., 1, :]
         out[:, :, k] = np.stack([a1, np.cross(frames[..., 2, :], a1), frames[..., 2, :]], axis=-2)

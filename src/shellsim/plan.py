@@ -33,8 +33,8 @@ def plan(deck: Deck) -> Plan:
     """The features ``deck`` needs."""
     return Plan({
         "large_strain": deck.section.technique is not None,
-        "hyperelastic": deck.material.HYPERELASTIC,
-        "anisotropic": deck.material.ANISOTROPIC,
+        "hyperelastic": any(m.HYPERELASTIC for m in deck.material),
+        "anisotropic": any(m.ANISOTROPIC for m in deck.material),
         "thickness_update": deck.thickness_update,
         "plane_strain": deck.section.plane_strain,
         **load_features([table for key in DECK_KEYS for table in getattr(deck, key)]),

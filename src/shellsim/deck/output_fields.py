@@ -39,14 +39,16 @@ def _needs_contact(what: str) -> Callable[[object], str | None]:
 
 
 def _needs_fibres(deck) -> str | None:
-    return None if deck.material.ANISOTROPIC else (f"is of a fibre-reinforced law's fibres, and material.model = "
-                                                   f"'{deck.material.model}' has none")
+    models = ", ".join(repr(m.model) for m in deck.material)
+    return None if any(m.ANISOTROPIC for m in deck.material) else (
+        f"is of a fibre-reinforced law's fibres, and material.model = {models} has none")
 
 
 def _needs_material_axes(deck) -> str | None:
     return None if deck.section.technique == 1 else (
         f"is in the axes of a hyperelastic material (section.technique = 1), and material.model = "
-        f"'{deck.material.model}' with section.technique = {deck.section.technique} has none")
+        f"{', '.join(repr(m.model) for m in deck.material)} with section.technique = {deck.section.technique} "
+        "has none")
 
 
 def _needs_vessel_axes(deck) -> str | None:

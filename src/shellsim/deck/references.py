@@ -74,6 +74,9 @@ def check_references(deck: Deck, geometry_sets: dict[str, str] | None) -> list[s
                 problems.append(f"cable[{i}].name: '{table.name}' adds the set '{name}', which is already "
                                 f"{taken[name]}; choose another name")
             taken[name] = f"cable[{i}]'s"
+    for i, material in enumerate(deck.material):
+        for name in material.sets:
+            need_set(f"material[{i}].sets", name, ("surface",))
     for i, bc in enumerate(deck.boundary):
         need_set(f"boundary[{i}].set", bc.set)
         need_curve(f"boundary[{i}].curve", getattr(bc, "curve", None))

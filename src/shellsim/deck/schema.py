@@ -12,7 +12,7 @@ from itertools import combinations
 from typing import Annotated, Literal, Union, get_args
 
 import numpy as np
-from pydantic import BeforeValidator, Field, create_model, field_validator, model_validator
+from pydantic import BeforeValidator, Field, create_model, field_serializer, field_validator, model_validator
 
 from .curves import Curve
 from .output_fields import FIELD_KINDS, WRITTEN_AS, field_problems
@@ -482,6 +482,22 @@ def _one_or_many(value: object) -> object:
     return [value] if isinstance(value, dict) else value
 
 
+def _part_problems(materials: list) -> list[str]:
+    """Several materials each name the sets they cover, and no set twice."""
+    if len(materials) == 1:
+        return []
+    problems = [f"material[{i}].sets: missing; with several materials each names the surface sets it covers"
+                for i, m in enumerate(materials) if not m.sets]
+    first: dict[str, int] = {}
+    for i, m in enumerate(materials):
+        for name in m.sets:
+            if name in first:
+                problems.append(f"material[{i}].sets: '{name}' is already material[{first[name]}]'s; an element "
+                                "has one material")
+            first.setdefault(name, i)
+    return problems
+
+
 def _constitutive_path_problems(material, section: ShellSection) -> list[str]:
     """What the element cannot run of this material and section: a hyperelastic law
     runs Technique 1 in the total formulation; Techniques 2 and 3 take a linear elastic
@@ -531,7 +547,7 @@ class Deck(Section):
     meta: Meta
     geometry: Geometry
     mesh: MeshOptions = MeshOptions()
-    material: Material
+    material: Annotated[list[Material], BeforeValidator(_one_or_many), Field(min_length=1)]
     section: ShellSection
     boundary: list[Boundary] = []
     load: list[Load] = []
@@ -561,23 +577,34 @@ class Deck(Section):
         mesh = data.get("mesh", {})
         if builder is not None and isinstance(mesh, dict) and isinstance(mesh.get("divisions", {}), dict):
             data["mesh"] = mesh | {"divisions": builder.DIVISIONS | mesh.get("divisions", {})}
-        model = MATERIALS.get(_tag(data.get("material"), "model"))
+        materials = [(table, MATERIALS.get(_tag(table, "model"))) for table in _one_or_many(data.get("material"))
+                     if isinstance(table, dict)] if isinstance(data.get("material"), (dict, list)) else []
         section = data.get("section")
-        if model is not None and model.HYPERELASTIC and isinstance(section, dict):
+        if any(model is not None and model.HYPERELASTIC for _, model in materials) and isinstance(section, dict):
             data["section"] = {"technique": 1} | section
-        output, material = data.get("output"), data.get("material")
-        if (isinstance(output, dict) and "vessel_stress" in output.get("fields", []) and "vessel_axes" not in output
-                and model is not None and model.ANISOTROPIC and isinstance(material, dict)):
-            axes = material.get("axes", {"kind": "cylindrical"})  # the law's own default
-            if isinstance(axes, dict) and axes.get("kind") in ("cylindrical", "centreline"):
-                data["output"] = output | {"vessel_axes": {key: value for key, value in axes.items()
-                                                           if key != "angle_deg"}}
+        output = data.get("output")
+        if isinstance(output, dict) and "vessel_stress" in output.get("fields", []) and "vessel_axes" not in output:
+            for table, model in materials:  # the first fibre-reinforced material's tube or centreline
+                axes = table.get("axes", {"kind": "cylindrical"})  # the law's own default
+                if (model is not None and model.ANISOTROPIC and isinstance(axes, dict)
+                        and axes.get("kind") in ("cylindrical", "centreline")):
+                    data["output"] = output | {"vessel_axes": {key: value for key, value in axes.items()
+                                                               if key != "angle_deg"}}
+                    break
         return data
+
+    @field_serializer("material", mode="wrap")
+    def _one_table(self, materials: list, handler) -> dict | list:
+        """One material covering every element is written as the one table it was."""
+        tables = handler(materials)
+        return tables[0] if len(tables) == 1 and not tables[0].get("sets") else tables
 
     @model_validator(mode="after")
     def _consistent(self) -> "Deck":
         problems = division_problems(self.geometry, self.mesh)
-        problems += _constitutive_path_problems(self.material, self.section)
+        problems += _part_problems(self.material)
+        for material in self.material:
+            problems += _constitutive_path_problems(material, self.section)
         problems += _mirror_problems(self.output.mirror, self.boundary)
         problems += field_problems(self)
         if self.output.checkpoint_interval is not None and self.solver.method == "static":

@@ -16,7 +16,8 @@ import numpy as np
 from numba import get_num_threads, njit, prange
 
 from .frames import director_increments, to_rotational
-from .groups import gather_element_values, gather_nodal_vectors, gather_shape, group_count, scatter_element_values
+from .groups import (gather_element_values, gather_members_shape, gather_nodal_vectors, group_count,
+                     part_group_members, scatter_element_values)
 from .response import group_arrays
 from .steps import steps_of
 from ..compiled_call import TypedCall
@@ -69,7 +70,7 @@ def _all_elements(response, steps, rule, body, material, shape, ux, ud, stress, 
     into lambda_3 (a loop no energy stands behind, which broke Test 10 down). The updated
     h moves the faces (pressure, probes), masses and volume.
     """
-    groups = group_count(body.conn.shape[0])
+    groups = body.group_part.shape[0]
     chunks = parts.chunks
     # the chunks' bodies run in a function of their own: a nested bundle cannot cross into
     # a prange body, and code written inline there was compiled wrongly
@@ -99,7 +100,9 @@ def run_groups(response, start, stop, steps, rule, body, material, shape, ux, ud
     members = group.members
     lengths = body.h0 if steps.hyperelastic else shape.h
     for g in range(start, stop):
-        count = gather_shape(g, conn, (shape.x, shape.d, lengths), members, (group.xe, group.de, group.he))
+        count = part_group_members(g, body.group_start, body.group_order, members)
+        gather_members_shape(conn, (shape.x, shape.d, lengths), members, (group.xe, group.de, group.he))
+        group.part[0] = body.group_part[g]
         gather_element_values(body.jac0_inv, members, group.jac0)
         if steps.hyperelastic:
             gather_element_values(material.axes0, members, group.axes0)

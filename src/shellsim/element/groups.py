@@ -1,11 +1,14 @@
 """Element groups: group g holds elements g * LANES ... g * LANES + LANES - 1
 (:data:`shellsim.lanes.LANES`), gathered into lanes and put back. A group at the end of
 the mesh fills its spare lanes with the last element again: computed like the others,
-never written back.
+never written back. The element loops group the elements of each part (material) apart
+(:func:`part_groups`): a group then holds elements of one part, its spare lanes its last
+element again.
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 from ..array_copy import copy_into
@@ -28,18 +31,49 @@ def group_members(group, ne, members):
     return min(LANES, ne - start)
 
 
+def part_groups(part: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(start (G + 1,), order (ne,), group_part (G,)): groups of at most LANES elements of
+    one part each, for each element's ``part`` (ne,); group g holds elements
+    order[start[g]:start[g + 1]], in ascending order within each part. One part gives
+    the groups of :func:`group_members`."""
+    order = np.argsort(part, kind="stable").astype(np.int64)
+    starts, parts = [], []
+    for p in np.unique(part):
+        first, stop = np.searchsorted(part[order], p), np.searchsorted(part[order], p, side="right")
+        starts += range(first, stop, LANES)
+        parts += [p] * len(range(first, stop, LANES))
+    return np.array(starts + [len(part)], dtype=np.int64), order, np.array(parts, dtype=np.int64)
+
+
+@njit(cache=True, error_model="numpy")
+def part_group_members(group, start, order, members):
+    """Write the members of group ``group`` of :func:`part_groups` into members (G,)
+    (spare lanes repeat its last element) and return how many lanes hold elements of
+    their own."""
+    first, stop = start[group], start[group + 1]
+    for lane in range(LANES):
+        members[lane] = order[min(first + lane, stop - 1)]
+    return stop - first
+
+
 @njit(cache=True, error_model="numpy")
 def gather_shape(group, conn, nodes, members, element):
     """A group's members (:func:`group_members`) and element = (xe, de, he): their
     positions and directors (9, 3, G) and fibre lengths (9, G) from nodes = (x, d, h),
     the nodal (n, 3), (n, 3) and (n,); returns how many lanes hold elements of their own."""
+    count = group_members(group, conn.shape[0], members)
+    gather_members_shape(conn, nodes, members, element)
+    return count
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def gather_members_shape(conn, nodes, members, element):
+    """element = (xe, de, he) of the elements ``members`` (G,), as :func:`gather_shape`."""
     x, d, h = nodes
     xe, de, he = element
-    count = group_members(group, conn.shape[0], members)
     gather_nodal_vectors(conn, members, x, xe)
     gather_nodal_vectors(conn, members, d, de)
     gather_nodal_scalars(conn, members, h, he)
-    return count
 
 
 @njit(cache=True, error_model="numpy")

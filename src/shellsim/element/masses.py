@@ -14,7 +14,7 @@ from .groups import gather_shape, group_count, lane_copy
 def lumped_masses(rule, body, shape, density, hughes, mt, mr):
     """Lumped nodal masses on the current ``shape`` (thesis 3.14); rule, body: the
     element's :class:`~shellsim.bundles.Rule` and the mesh's :class:`~shellsim.bundles.Body`;
-    density [mass / length^3].
+    density (ne,) each element's [mass / length^3].
 
     hughes=True gives M1 (Hughes et al. 1981): translational masses proportional to
     int N_a^2 rho dV, scaled to the element mass; rotational ones are those times
@@ -46,14 +46,14 @@ def lumped_masses(rule, body, shape, density, hughes, mt, mr):
                     volume[lane] += dv
                     if hughes:
                         for a in range(9):
-                            raw[a, lane] += N[p, a] * N[p, a] * density * dv
+                            raw[a, lane] += N[p, a] * N[p, a] * density[members[lane]] * dv
                     else:
                         hbar = 0.0
                         for b in range(9):
                             hbar += N[p, b] * he[b, lane]
                         for a in range(9):
-                            raw[a, lane] += N[p, a] * density * dv
-                            rot[a, lane] += N[p, a] * density * dv * he[a, lane] * hbar / 12.0
+                            raw[a, lane] += N[p, a] * density[members[lane]] * dv
+                            rot[a, lane] += N[p, a] * density[members[lane]] * dv * he[a, lane] * hbar / 12.0
         for lane in range(count):
             lane_copy(raw, lane, raw1)
             lane_copy(rot, lane, rot1)
@@ -62,7 +62,7 @@ def lumped_masses(rule, body, shape, density, hughes, mt, mr):
                 total = raw1.sum()
                 area = volume[lane] / he1.mean()
                 for a in range(9):
-                    m = density * volume[lane] * raw1[a] / total
+                    m = density[members[lane]] * volume[lane] * raw1[a] / total
                     rot1[a] = m * max(he1[a] * he1[a] / 12.0, area / 8.0)
                     raw1[a] = m
             e = members[lane]

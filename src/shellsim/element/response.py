@@ -28,7 +28,8 @@ from .stress_update import constant_tensor, convected_layer, hyperelastic_layers
 
 class Group(NamedTuple):
     """An element group as gathered and its results (G = LANES lanes, nq Gauss points, nt
-    layers, npts points): members (G,) element numbers; xe, de, ue, ve (9, 3, G)
+    layers, npts points): members (G,) element numbers; part (1,) the part (material)
+    they all belong to; xe, de, ue, ve (9, 3, G)
     positions, directors and the field's increments; he (9, G) fibre lengths; jac0
     (npts, nt, 3, 3, G) inverse initial Jacobians; axes0 (nq, nt, 3, 3, G) initial
     material frames (Technique 1); state_stress (nq, nt, 5, G) the state's lamina stresses
@@ -36,6 +37,7 @@ class Group(NamedTuple):
     first when incremental); stretch (nq, G) normal stretches; fe, ge (9, 3, G) nodal forces."""
 
     members: np.ndarray
+    part: np.ndarray
     xe: np.ndarray
     de: np.ndarray
     ue: np.ndarray
@@ -112,7 +114,8 @@ def group_arrays(npts, nt, nq, nb):
     Gauss points and nb volumetric fields."""
     g = LANES
     group = Group(
-        members=np.zeros(g, dtype=np.int64), xe=np.empty((9, 3, g)), de=np.empty((9, 3, g)), ue=np.zeros((9, 3, g)),
+        members=np.zeros(g, dtype=np.int64), part=np.zeros(1, dtype=np.int64), xe=np.empty((9, 3, g)),
+        de=np.empty((9, 3, g)), ue=np.zeros((9, 3, g)),
         ve=np.zeros((9, 3, g)), he=np.empty((9, g)), jac0=np.empty((npts, nt, 3, 3, g)),
         axes0=np.empty((nq, nt, 3, 3, g)), state_stress=np.zeros((nq, nt, 5, g)), stress=np.zeros((nq, nt, 5, g)),
         stretch=np.ones((nq, g)), fe=np.empty((9, 3, g)), ge=np.empty((9, 3, g)))
@@ -259,7 +262,7 @@ def _stresses(steps, rule, material, group, points, scratch):
             if steps.convected:
                 group.stretch[p, :] = 1.0
             for k in range(nt):
-                constant_tensor(material.C, points.EPS[p, k], stress[p, k], steps.incremental)
+                constant_tensor(material.C[group.part[0]], points.EPS[p, k], stress[p, k], steps.incremental)
                 if steps.convected:
                     convected_layer(material, group, points, scratch, p, k, share[k])
         for k in range(nt):

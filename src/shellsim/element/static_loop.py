@@ -16,7 +16,6 @@ import numpy as np
 from numba import njit
 
 from .assembly import after_groups, run_groups
-from .groups import group_count
 from .steps import steps_of
 from .tangent import ELEMENT_DOFS, element_tangents
 from ..compiled_call import TypedCall
@@ -65,7 +64,7 @@ class ElementLoop:
         rule, body, material = structure
         over_threads(lambda first, last: self._forces(self._response, first, last, False, structure, shape,
                                                       (dx, dd, stress), parts, _NO_STEPS, False, _NO_BLOCKS),
-                     group_count(len(body.conn)))
+                     len(body.group_part))
         self._after(self._steps(material, np.bool_(False)), body, shape, parts, f, fr)
 
     def tangents(self, structure, shape, converged, differences, central, parts, k) -> None:

@@ -75,18 +75,18 @@ def hyperelastic_layers(product, material, group, points, scratch, p, share):
                 for j in range(3):
                     for lane in range(LANES):
                         Emean[i, j, lane] += share[k] * E[i, j, lane]
-        zero_normal_stress.stress(material, E, S, Cinv, pressure, volume, law_work)
+        zero_normal_stress.stress(material, group.part[0], E, S, Cinv, pressure, volume, law_work)
         if product:  # the tangent at the current state times the field's strain
             D[:] = 0.0
             _add_strain_tensor(points.EPS[p, k], 1.0, D)
             to_global(Fl, D, dE)
-            zero_normal_stress.tangent(material, E, Cinv, pressure, dE, dS, law_work)
+            zero_normal_stress.tangent(material, group.part[0], E, Cinv, pressure, dE, dS, law_work)
             S = dS
         _push_forward(Fl, S, volume, tmp, group.stress[p, k])
         for lane in range(LANES):
             points.DV[p, k, lane] *= volume[lane] / det[lane]
     if not product:
-        zero_normal_stress.normal_strain(material, Emean, group.stretch[p], law_work)
+        zero_normal_stress.normal_strain(material, group.part[0], Emean, group.stretch[p], law_work)
 
 
 @njit(cache=True, error_model="numpy")
@@ -98,7 +98,7 @@ def convected_layer(material, group, points, scratch, p, k, share):
     lamina frame."""
     normal, s5, M = scratch.normal, group.stress[p, k], scratch.M
     for lane in range(LANES):
-        normal[lane] = -material.normal_ratio * (points.EPS[p, k, 0, lane] + points.EPS[p, k, 1, lane])
+        normal[lane] = -material.normal_ratio[group.part[0]] * (points.EPS[p, k, 0, lane] + points.EPS[p, k, 1, lane])
         group.stretch[p, lane] += share * normal[lane]
     if material.push_forward:
         _convect(s5, points.EPS[p, k], normal, M[0], M[1], M[2], scratch.det)

@@ -106,6 +106,7 @@ def _element_tangent(response, e, path, rule, body, material, shape, dx, dd, str
     group, points, scratch = group_arrays(rule.N.shape[0], nt, nq, rule.vol_basis.shape[1])
     members = group.members
     members[:] = e
+    group.part[0] = body.part[e]
     gather_nodal_scalars(conn, members, body.h0 if path.hyperelastic else shape.h, group.he)
     gather_element_values(body.jac0_inv, members, group.jac0)
     if path.hyperelastic:

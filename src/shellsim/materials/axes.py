@@ -11,6 +11,7 @@ from pydantic import Field, field_validator, model_validator
 
 from ..errors import MeshError
 from ..table_types import Name, Section, Vec3
+from .table import MaterialTable
 
 #: An angle of material axis 1 about the lamina normal (degrees).
 Angle = Annotated[float, Field(strict=True, ge=-180.0, le=180.0, allow_inf_nan=False)]
@@ -133,7 +134,7 @@ def _nonzero_vector(v: tuple[float, float, float]) -> tuple[float, float, float]
     return v
 
 
-class AnisotropicLaw(Section):
+class AnisotropicLaw(MaterialTable):
     """The base of an anisotropic hyperelastic law's ``[material]`` table, which declares
     ``axes: Axes`` among its own fields: cylindrical axes when the deck gives none."""
 

@@ -1,5 +1,5 @@
 """The hyperelastic laws of Technique 1 (thesis 3.10.1): their registry, and a law's
-compiled functions held for the element path (:func:`held_law`).
+compiled functions held for the element path (:func:`held_laws`).
 
 A law is one module of this package with
 - ``INCOMPRESSIBLE``: J = 1 (zero normal stress by the determinant condition), or a
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from numba import types
 
-from ..compiled_call import held_by_address
+from ..compiled_call import held_by_address, hold_also
 from ..table_types import tag_of
 from . import guccione, hgo, lee_sacks, mooney_rivlin, st_venant_kirchhoff
 from .linear import LinearElastic
@@ -43,11 +43,17 @@ def law_of(model: str):
 _PARAMS, _TENSOR = types.Array(types.float64, 1, "C"), types.Array(types.float64, 3, "C")
 
 
-def held_law(code: int) -> tuple:
-    """(energy_stress, energy_tangent) of the law with that code, held for the element
-    path (:class:`shellsim.bundles.Material`), which calls them through their addresses
-    (:func:`shellsim.compiled_call.held_by_address`): only a scene's own law compiles,
-    and the element path compiles none of the laws' code into its own."""
-    law = LAWS[code]
-    return (held_by_address(law.energy_stress, types.none(_PARAMS, _TENSOR, _TENSOR)),
-            held_by_address(law.energy_tangent, types.none(_PARAMS, _TENSOR, _TENSOR, _TENSOR)))
+def held_laws(codes: list[int]) -> tuple:
+    """(energy_stress, energy_tangent) of the laws with those codes, one per part of the
+    model, each held for the element path (:class:`shellsim.bundles.Material`), which
+    calls the part's through its address (:func:`shellsim.compiled_call.held_by_address`):
+    only a scene's own laws compile, and the element path compiles none of the laws' code
+    into its own."""
+    held = []
+    for name, signature in (("energy_stress", types.none(_PARAMS, _TENSOR, _TENSOR)),
+                            ("energy_tangent", types.none(_PARAMS, _TENSOR, _TENSOR, _TENSOR))):
+        functions = held_by_address(getattr(LAWS[codes[0]], name), signature)
+        for code in codes[1:]:
+            hold_also(functions, getattr(LAWS[code], name), signature)
+        held.append(functions)
+    return tuple(held)

@@ -14,7 +14,8 @@ from typing import ClassVar, Literal
 import numpy as np
 from pydantic import field_validator
 
-from ..table_types import Positive, Real, Section
+from ..table_types import Positive, Real
+from .table import MaterialTable
 
 #: Transverse shear correction factor on the 13 and 23 shear moduli (Reissner-Mindlin,
 #: the value Hughes-Liu shells and LS-DYNA's SHRF default use). The thesis does not state
@@ -22,7 +23,7 @@ from ..table_types import Positive, Real, Section
 SHEAR_FACTOR = 5.0 / 6.0
 
 
-class LinearElastic(Section):
+class LinearElastic(MaterialTable):
     """Isotropic linear elastic (small strain; St. Venant-Kirchhoff under Technique 1)."""
 
     model: Literal["linear_elastic"]

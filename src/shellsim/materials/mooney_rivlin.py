@@ -23,12 +23,13 @@ import numpy as np
 from numba import njit
 from pydantic import Field
 
-from ..table_types import Positive, Section
+from ..table_types import Positive
 from ..lanes import LANES
+from .table import MaterialTable
 
 
 
-class NeoHookean(Section):
+class NeoHookean(MaterialTable):
     """Incompressible neo-Hookean: W = C1 (I1 - 3)."""
 
     model: Literal["neo_hookean"]
@@ -38,7 +39,7 @@ class NeoHookean(Section):
     ANISOTROPIC: ClassVar[bool] = False
 
 
-class MooneyRivlin(Section):
+class MooneyRivlin(MaterialTable):
     """Incompressible Mooney-Rivlin: W = C1 (I1 - 3) + C2 (I2 - 3), C1 > 0, C2 >= 0."""
 
     model: Literal["mooney_rivlin"]

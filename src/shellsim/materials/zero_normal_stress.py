@@ -21,9 +21,10 @@ Compressible laws (St. Venant-Kirchhoff) whose S^w_33 is linear in E33: S_33 = 0
 E33 = -S^w_33(E33 = 0) / CC^w_3333 and dE33 = -(CC^w : dE)_33 / CC^w_3333 for a dE with
 no normal part; S~ = S^w, no pressure, J = sqrt(det C).
 
-The law's own S^w and CC^w : dE are the functions ``material`` holds (the kernels'
-:class:`shellsim.bundles.Material`: energy_stress, energy_tangent, params,
-incompressible). Scratch ``work`` (3, 3, 3, G).
+The law's own S^w and CC^w : dE are the functions ``material`` holds for each part of
+the model (the kernels' :class:`shellsim.bundles.Material`: energy_stress,
+energy_tangent, params, incompressible, by part); ``part`` picks the group's. Scratch
+``work`` (3, 3, 3, G).
 """
 
 from __future__ import annotations
@@ -36,10 +37,10 @@ from ..tensor3 import det3, to_lamina
 
 
 @njit(cache=True, error_model="numpy")
-def normal_strain(material, E, stretch, work):
+def normal_strain(material, part, E, stretch, work):
     """Set E[2, 2] (3, 3, G) for zero normal stress; stretch (G,) = sqrt(1 + 2 E33), the
     normal stretch."""
-    if material.incompressible:
+    if material.incompressible[part]:
         solve_normal_strain(E, stretch)
         return
     S, unit, dS = work[0], work[1], work[2]
@@ -47,8 +48,8 @@ def normal_strain(material, E, stretch, work):
     for lane in range(LANES):
         E[2, 2, lane] = 0.0
         unit[2, 2, lane] = 1.0
-    material.energy_stress[0](material.params, E, S)
-    material.energy_tangent[0](material.params, E, unit, dS)
+    material.energy_stress[part](material.params[part], E, S)
+    material.energy_tangent[part](material.params[part], E, unit, dS)
     for lane in range(LANES):
         E[2, 2, lane] = -S[2, 2, lane] / dS[2, 2, lane]
         stretch[lane] = np.sqrt(1.0 + 2.0 * E[2, 2, lane])
@@ -69,17 +70,17 @@ def solve_normal_strain(E, stretch):
 
 
 @njit(cache=True, error_model="numpy")
-def stress(material, E, S, Cinv, pressure, volume, work):
+def stress(material, part, E, S, Cinv, pressure, volume, work):
     """Second Piola stress S~ (3, 3, G) under zero normal stress (S33 = 0).
 
     E (3, 3, G): strains with any E33, which is replaced by the solution. Writes S, Cinv
     (3, 3, G) = (2E + I)^-1 (incompressible; else untouched), pressure (G,) the
     constraint's Lagrange multiplier p (0 for a compressible law) and volume (G,) the
     volume ratio J (1 for an incompressible law)."""
-    normal_strain(material, E, volume, work)
-    if material.incompressible:
+    normal_strain(material, part, E, volume, work)
+    if material.incompressible[part]:
         _inverse_stretch(E, Cinv)
-        material.energy_stress[0](material.params, E, S)
+        material.energy_stress[part](material.params[part], E, S)
         for lane in range(LANES):
             pressure[lane] = S[2, 2, lane] / Cinv[2, 2, lane]
             volume[lane] = 1.0
@@ -88,7 +89,7 @@ def stress(material, E, S, Cinv, pressure, volume, work):
                 for lane in range(LANES):
                     S[i, j, lane] -= pressure[lane] * Cinv[i, j, lane]
     else:
-        material.energy_stress[0](material.params, E, S)
+        material.energy_stress[part](material.params[part], E, S)
         C = work[0]
         for i in range(3):
             for j in range(3):
@@ -103,11 +104,11 @@ def stress(material, E, S, Cinv, pressure, volume, work):
 
 
 @njit(cache=True, error_model="numpy")
-def tangent(material, E, Cinv, pressure, dE, dS, work):
+def tangent(material, part, E, Cinv, pressure, dE, dS, work):
     """dS~ (3, 3, G) for strain directions dE (3, 3, G) at a solved state (E, Cinv,
     pressure from :func:`stress`). dE[2, 2] is overwritten by the constraint's value."""
-    energy_tangent, params = material.energy_tangent[0], material.params
-    if material.incompressible:
+    energy_tangent, params = material.energy_tangent[part], material.params[part]
+    if material.incompressible[part]:
         for lane in range(LANES):
             acc = 0.0
             for i in range(3):

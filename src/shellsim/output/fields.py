@@ -172,12 +172,22 @@ def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
     ``layers`` (indices into the thickness rule), (ne, nq, len(layers), 3) per family: its
     initial unit direction a0 (the law's ``fibres`` in the initial material frame) carried
     by the deformation gradient (:func:`~shellsim.output.derived.deformation_gradients`);
-    its length is the fibre's stretch, sqrt(I4)."""
-    model = sim.model
+    its length is the fibre's stretch, sqrt(I4). Family k of each part's law; NaN in the
+    elements of a part whose law has fewer families."""
+    material, part = sim.model.material, sim.model.body.part
     F, _ = deformation_gradients(sim, layers)
-    frames = model.material.axes0[:, :, layers]  # rows: material axes 1, 2, 3
-    return [np.einsum("eqkij,eqkj->eqki", F, c * frames[..., 0, :] + s * frames[..., 1, :])
-            for c, s in LAWS[model.material.law].fibres(model.material.params)]
+    frames = material.axes0[:, :, layers]  # rows: material axes 1, 2, 3
+    directions = [LAWS[law].fibres(params) for law, params in zip(material.law, material.params)]
+    vectors = []
+    for family in range(max(len(fibres) for fibres in directions)):
+        a0 = np.full(frames.shape[:-1], np.nan)
+        for i, fibres in enumerate(directions):
+            if family < len(fibres):
+                c, s = fibres[family]
+                mine = part == i
+                a0[mine] = c * frames[mine][..., 0, :] + s * frames[mine][..., 1, :]
+        vectors.append(np.einsum("eqkij,eqkj->eqki", F, a0))
+    return vectors
 
 
 def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.ndarray:

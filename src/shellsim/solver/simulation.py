@@ -95,7 +95,7 @@ class Simulation:
         """Lumped masses on the current configuration (M1 or M2, thesis 3.14), the cables'
         added, all times ``mass_factor``."""
         m, s = self.model, self.state
-        self.compiled.masses(m.rule, m.body, s.fields.shape, float(m.density), m.mass == "M1", s.mt, s.mr)
+        self.compiled.masses(m.rule, m.body, s.fields.shape, m.body.density, m.mass == "M1", s.mt, s.mr)
         add_masses(m, s.mt, s.mr)
         if self.mass_factor != 1.0:
             s.mt *= self.mass_factor
@@ -107,7 +107,7 @@ class Simulation:
         m, s = self.model, self.state
         shape = Shape(x=m.x0, d=m.d0, e1=m.e1f0, h=m.h0) if initial else s.fields.shape
         mt, mr = np.empty(m.n_nodes), np.empty(m.n_nodes)
-        self.compiled.masses(m.rule, m.body, shape, 1.0, False, mt, mr)
+        self.compiled.masses(m.rule, m.body, shape, np.ones(m.n_elements), False, mt, mr)
         return float(mt.sum())
 
     def point_tensors(self, elements=slice(None), points=slice(None)) -> tuple[np.ndarray, ...]:

@@ -152,3 +152,30 @@ def test_the_chords_ogden_law_of_three_terms_comes_over_term_by_term(tmp_path, d
     assert [c["law"] for c in model.tables["cable"]] == [law, law]
     assert not [line for line in model.unmapped if "Chorda" in line or "1D law" in line]
     Ogden(**law)
+
+
+def test_each_section_s_material_comes_over_as_a_part_of_its_own(tmp_path):
+    """The triangles' section names a material of its own (neo-Hooke, C10 = 0.5): the deck
+    has two [[material]] tables, the quads' HGO law with its fibre axes on the belly's set
+    and the neo-Hookean one on the edge's, nothing listed about a material, and
+    ``shellsim import`` writes a deck that ``check`` accepts with each part's law."""
+    from typer.testing import CliRunner
+
+    from shellsim.cli import app
+
+    path = tmp_path / "valve_patch.inp"
+    path.write_text(abaqus_model().replace("*Shell Section, elset=Edge, material=Leaflet, orientation=Ori",
+                                           "*Shell Section, elset=Edge, material=Stiff")
+                    + "*Material, name=Stiff\n*Density\n1.3e-9\n*Hyperelastic, neo hooke\n0.5, 0.\n")
+    model = read_foreign(path)
+    belly, edge = model.tables["material"]
+    assert belly["model"] == "hgo" and belly["sets"] == ["Patch-1_Belly"] and belly["axes"]["kind"] == "mesh"
+    assert edge == {"sets": ["Patch-1_Edge"], "model": "neo_hookean", "C1": 0.5, "density": 1.3e-9}
+    assert not [line for line in model.unmapped if "material" in line.lower()], model.unmapped
+    runner = CliRunner()
+    result = runner.invoke(app, ["import", str(path), "--out", str(tmp_path / "deck")])
+    assert result.exit_code == 0, result.output
+    checked = runner.invoke(app, ["check", str(tmp_path / "deck" / "deck.toml")])
+    said = " ".join(checked.output.replace("│", " ").split())
+    assert checked.exit_code == 0, checked.output
+    assert "hgo (" in said and "on 'Patch-1_Belly'" in said and "neo_hookean (C1=0.5, density=1.3e-09) on 'Patch-1_Edge'" in said

@@ -204,3 +204,19 @@ def test_a_febio_model_comes_back_whole(tmp_path, version):
                 r"8 triangle\(s\) \(first at valve_patch\.feb:\d+\): each split into three quads"]
     assert len(model.unmapped) == len(expected), model.unmapped
     assert all(any(re.search(pattern, line) for line in model.unmapped) for pattern in expected), model.unmapped
+
+
+def test_each_shell_domain_s_material_comes_over_as_a_part_of_its_own(tmp_path):
+    """The edge's shell domain takes a Mooney-Rivlin material of its own: two [[material]]
+    tables, the HGO law on the belly's set and the Mooney-Rivlin one (c1, c2) on the
+    edge's, nothing listed about a material."""
+    path = tmp_path / "valve_patch.feb"
+    path.write_text(febio_model("4.0").replace('<ShellDomain name="Edge" mat="Leaflet"/>',
+                                               '<ShellDomain name="Edge" mat="Stiff"/>')
+                    .replace("</Material>", '<material id="3" name="Stiff" type="Mooney-Rivlin"><density>1.3e-9'
+                                            "</density><c1>0.4</c1><c2>0.1</c2></material></Material>"))
+    model = read_foreign(path)
+    belly, edge = model.tables["material"]
+    assert belly["model"] == "hgo" and belly["sets"] == ["Belly"]
+    assert edge == {"sets": ["Edge"], "model": "mooney_rivlin", "C1": 0.4, "C2": 0.1, "density": 1.3e-9}
+    assert not [line for line in model.unmapped if "material" in line.lower()], model.unmapped

@@ -157,7 +157,7 @@ class _Builder:
         m = self.model
         covered = np.zeros(len(self.shells.conn), dtype=bool)
         thickness = np.full(len(self.shells.conn), np.nan)
-        chosen = None
+        parts: dict[tuple[str, str], tuple[Keyword, str, list[str]]] = {}  # (material, orientation) -> section, prefix, sets
         cables = []
         for k, elset, prefix in m.sections:
             elements = self.shells.elements_of(m.elsets[elset].items)
@@ -175,15 +175,8 @@ class _Builder:
                 continue
             covered[elements] = True
             thickness[elements] = float(k.rows[0][0])
-            material = (k.param("material") or "").lower()
-            if chosen is None:
-                chosen = (material, k, prefix)
-            elif material != chosen[0]:
-                mask = np.zeros(len(self.shells.conn), dtype=bool)
-                mask[elements] = True
-                m.unmapped.append(f"{k.label()}: material '{k.param('material')}' on elements "
-                                  f"{listed(self.shells.labels_of(mask))}: a deck has one material; "
-                                  f"'{chosen[1].param('material')}' is used everywhere")
+            part = ((k.param("material") or "").lower(), (k.param("orientation") or "").lower())
+            parts.setdefault(part, (k, prefix, []))[2].append(self.shells.set_of[("elset", elset)])
             offset = (k.param("offset") or "0").upper()
             if offset not in ("MIDDLE", "SMID") and not (_is_number(offset) and float(offset) == 0.0):
                 m.unmapped.append(f"{k.label()}: OFFSET={k.param('offset')} is not read (shellsim's reference surface "
@@ -195,7 +188,7 @@ class _Builder:
         if not covered.all():
             raise MeshError(f"model file '{m.path}': shell elements without a shell section: "
                             f"{listed(self.shells.labels_of(~covered))}")
-        if chosen is None:
+        if not parts:
             raise MeshError(f"model file '{m.path}' has no *SHELL SECTION")
         values, counts = np.unique(thickness, return_counts=True)
         section: dict = {"thickness": float(values[counts.argmax()])}  # the mesh file's nodal values rule where they differ
@@ -205,11 +198,11 @@ class _Builder:
             np.add.at(total, self.shells.conn, thickness[:, None])
             np.add.at(count, self.shells.conn, 1.0)
             self.shells.thickness = total / np.maximum(count, 1.0)  # a cable's own node: 0
-        material = self._material(*chosen)
-        if material is not None:
-            if material["model"] != "linear_elastic" or "nlgeom" in self._step_params():
+        materials = self._materials(parts)
+        if materials:
+            if any(t["model"] != "linear_elastic" for t in materials) or "nlgeom" in self._step_params():
                 section["technique"] = 1
-            self.tables["material"] = material
+            self.tables["material"] = materials[0] if len(parts) == 1 else materials
         self.tables["section"] = section
         if cables:
             self.tables["cable"] = cables
@@ -284,6 +277,23 @@ class _Builder:
     def _step_params(self) -> dict[str, str]:
         step = self.model.steps[0][0].params if self.model.steps else {}
         return {k: v for k, v in step.items() if not (k == "nlgeom" and v.upper() in ("NO", "OFF"))}
+
+    def _materials(self, parts: dict[tuple[str, str], tuple[Keyword, str, list[str]]]) -> list[dict]:
+        """A material table for each (material, orientation) of the shell sections, naming
+        the sets of its sections' elements where there are several; the density the file's
+        gravity loads take is the first material's."""
+        tables, first_density = [], None
+        for (key, _), (section, prefix, sets) in parts.items():
+            table = self._material(key, section, prefix)
+            first_density = self.density if first_density is None else first_density
+            if table is not None:
+                tables.append(({"sets": sets} if len(parts) > 1 else {}) | table)
+        unmapped = len(parts) - len(tables)
+        if unmapped and tables:
+            self.model.unmapped.append(f"{unmapped} of the {len(parts)} shell sections' materials map to no law "
+                                       "(listed above): their elements have no [[material]] table; add one for them")
+        self.density = first_density
+        return tables
 
     def _material(self, key: str, section: Keyword, prefix: str) -> dict | None:
         m = self.model

@@ -230,15 +230,34 @@ class _Reader:
 
     # -- material ---------------------------------------------------------------------------
     def _material(self) -> None:
-        materials = self.materials
-        used = list(dict.fromkeys(d.get("mat") for d in self.root.findall("MeshDomains/ShellDomain")))
-        if not used or used[0] not in materials:
-            raise MeshError(f"model file '{self.path}': the shell domain's material '{used[0] if used else ''}' is "
-                            "not defined")
-        for other in used[1:]:
-            self.unmapped.append(f"{self.where(materials[other])}: a deck has one material; "
-                                 f"'{used[0]}' is used everywhere")
-        m = materials[used[0]]
+        """A material table for each material of the shell domains, naming the sets of its
+        domains' elements where there are several; the density the file's gravity takes is
+        the first material's."""
+        materials, by_material = self.materials, {}
+        for domain in self.root.findall("MeshDomains/ShellDomain"):
+            if domain.get("mat") not in materials:
+                raise MeshError(f"{self.where(domain)}: the shell domain's material '{domain.get('mat') or ''}' is not "
+                                "defined")
+            by_material.setdefault(materials[domain.get("mat")], []).append(
+                self.shells.set_of[("elset", domain.get("name"))])
+        if not by_material:
+            raise MeshError(f"model file '{self.path}': no shell domain names a material")
+        tables, first_density = [], None
+        for m, sets in by_material.items():
+            table = self._material_table(m)
+            first_density = self.density if first_density is None else first_density
+            if table is not None:
+                tables.append(({"sets": sets} if len(by_material) > 1 else {}) | table)
+        if tables and len(tables) < len(by_material):
+            self.unmapped.append(f"{len(by_material) - len(tables)} of the shell domains' {len(by_material)} "
+                                 "materials map to no law (listed above): their elements have no [[material]] table; "
+                                 "add one for them")
+        self.density = first_density
+        if tables:
+            self.tables["material"] = tables[0] if len(by_material) == 1 else tables
+
+    def _material_table(self, m: ET.Element) -> dict | None:
+        """The material table of the FEBio material ``m``; None (listed) where it has no law."""
         kind = m.get("type")
         value = {child.tag: child.text for child in m}
 
@@ -264,14 +283,14 @@ class _Reader:
             self.unmapped.append(f"{self.where(m)}: the material type '{kind}' has no shellsim law; name one in "
                                  "[material] (e.g. 'lee_sacks' for leaflets, docs/decks.md)")
         if table is None:
-            return
+            return None
         if "k" in value and table["model"] != "linear_elastic":
             self.unmapped.append(f"{self.where(m)}: k = {value['k']} (bulk modulus) is dropped: shellsim's "
                                  "hyperelastic laws are incompressible")
         if self.density is None:
             self.unmapped.append(f"{self.where(m)}: no density; the deck's 1.0 is a placeholder (only an explicit "
                                  "run uses it)")
-        self.tables["material"] = table | {"density": self.density if self.density is not None else 1.0}
+        return table | {"density": self.density if self.density is not None else 1.0}
 
     def _cables(self) -> None:
         """A [[cable]] table for each beam domain of trusses: its line set, the domain's

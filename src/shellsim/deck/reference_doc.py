@@ -61,7 +61,11 @@ def deck_reference() -> str:
             lines += ["`[mesh] divisions` and their defaults: "
                       + ", ".join(f"`{k} = {v}`" for k, v in cls.DIVISIONS.items()), ""]
     lines += _table(schema.MeshOptions, "## [mesh]")
-    lines += ["## [material]", "", "Chosen by `model`.", ""]
+    lines += ["## [material] (one) or [[material]] (a material per part)", "",
+              "Chosen by `model`. One `[material]` table covers every element; with several "
+              "`[[material]]` tables each names the surface sets it covers in `sets` (every element in "
+              "exactly one), its law, constants, density and axes its own. The parts share `[section]` "
+              "and its technique.", ""]
     for cls in MATERIALS.values():
         lines += _table(cls, f'### model = "{_tag(cls)}"', skip_tag=True)
     lines += ["Material axes (`axes`), chosen by `kind`:", ""]

@@ -171,3 +171,12 @@ def test_an_assignment_with_gaps_overlaps_or_unnamed_parts_is_refused(tmp_path):
     with pytest.raises(MeshError, match=r"4 element\(s\) are in the sets of several materials \(material\[0\], "
                                         r"material\[1\]\): elements 1, 2, 3, 4 "):
         prepared(parse_deck(pulled(path, overlapping, 1.001)))
+
+
+def test_a_misspelt_key_of_one_part_s_table_is_named_with_its_part():
+    """Each [[material]] table is checked as its law's: a misspelt key is named with the
+    table's place and the keys that law takes."""
+    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0').replace(
+        "[material]", '[[material]]\nsets = ["all"]').replace("nu = 0.3", "nu = 0.3\nEE = 3.0")
+    assert "material[0].EE (line 10): unknown key 'EE'; did you mean 'E'?; keys here: sets, model, E, nu, density" \
+        in problems_of(text)

@@ -138,8 +138,10 @@ def _allowed_keys(root: type[BaseModel], data: Any, keys: list) -> list[str]:
     model: Any = root
     node = data
     for k in keys:
-        if isinstance(k, int):
+        if isinstance(k, int):  # an entry of a list of tables: the list's member model
             node = node[k]
+            listed = typing.get_args(model) if typing.get_origin(model) is list else (None,)
+            model = _pick_member(listed[0], node)
             continue
         model = _field_model(model, k, node)
         node = node.get(k) if isinstance(node, dict) else None
@@ -163,6 +165,8 @@ def _pick_member(annotation: Any, node: Any) -> Any:
         args = typing.get_args(annotation)
         if origin is typing.Annotated:
             annotation = args[0]
+        elif origin is list and isinstance(node, dict):
+            annotation = args[0]  # one table where a list of them is taken ([reference], [material])
         elif origin in (list, dict):
             return annotation  # the next key is an index or a name; resolved on the next step
         elif origin in (typing.Union, types.UnionType):

@@ -143,3 +143,25 @@ def test_friction_on_a_static_solve_is_refused_with_the_key_named():
     text = on_a_plane(1.0).replace("end_time = 1.0", 'method = "static"\nend_time = 1.0')
     with pytest.raises(DeckError, match=r"contact\[0\]\.friction = 0\.3: .* a static solve has none"):
         parse_deck(text)
+
+
+def test_mass_scaling_calibrates_the_contact_springs_on_the_scaled_masses(tmp_path):
+    """The pressed plates with friction, every mass scaled to four times the first step:
+    the contact springs are set again on the scaled masses and the scaled structure's
+    step, so their stiffness stays what it was (k = s m / dt^2: the factors cancel) while
+    friction's sticking impulse, m / dt, is the scaled nodes' (it was the unscaled ones',
+    1 / sqrt(16) of it)."""
+    from .conftest import pressed_plates_deck, prepared
+
+    def deck(solver: str):
+        return parse_deck(pressed_plates_deck(tmp_path / "plates.vtu", 0.01, solver, more="friction = 0.3"))
+
+    plain = prepared(deck("[solver]\nend_time = 1e-3\ndamping = 50.0"))
+    structure = float(plain.sim.critical_time_step())  # the shell's own, at rest
+    scaled = run_deck(deck(f"[solver]\nend_time = 1e-3\ndamping = 50.0\nmass_scaling = {{ step = {4.0 * structure!r} }}"))
+    contact = next(b for b in scaled.model.loads if b is not None and hasattr(b, "face_inverse_mass"))
+    s = scaled.sim.state
+    np.testing.assert_allclose(contact.inverse_mass, 1.0 / s.mt[contact.nodes], rtol=1e-12)
+    assert scaled.sim.mass_factor > 10.0
+    critical = np.sqrt(contact.penalty / contact.spring)  # the step the springs were set for
+    np.testing.assert_allclose(critical, structure * np.sqrt(scaled.sim.mass_factor), rtol=1e-3)

@@ -258,14 +258,17 @@ def _watch_quality(run: Run) -> None:
         run.lowest = run.worst
 
 
-def _update_time_step(run: Run, listener: Listener) -> None:
+def _update_time_step(run: Run, listener: Listener) -> float:
+    """The masses and the critical step (``run.dt_critical``) and step (``run.dt``) on the
+    current shape; returns the shell structure's own critical step."""
     _watch_quality(run)
     run.sim.update_masses()
-    run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, run.sim.critical_time_step(),
-                                  run.sim.mass_factor)
+    structure = run.sim.critical_time_step()
+    run.dt_critical = stable_step(run.model, run.sim.state.fields.shape, structure, run.sim.mass_factor)
     run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((run.sim.state.t, run.dt_critical, run.dt))
     listener.on_dt(run)
+    return structure
 
 
 #: Mass scaling beyond this factor (a step a thousand times the stable one) is refused:
@@ -275,7 +278,9 @@ MOST_MASS_FACTOR = 1e6
 
 def _scale_masses(run: Run, listener: Listener) -> None:
     """Mass scaling: when the first step is shorter than the deck's target, every mass
-    times (target / step)^2 and the step estimated again (a second entry at t = 0).
+    times (target / step)^2 and the step estimated again (a second entry at t = 0), the
+    penalty springs calibrated again on the scaled masses and step (the same stiffness;
+    friction's sticking impulse then the scaled nodes').
     Raises SceneTooLarge (the run refused) for a factor beyond MOST_MASS_FACTOR."""
     scaling = run.deck.solver.mass_scaling
     if scaling is None or run.dt >= scaling.step:
@@ -287,7 +292,10 @@ def _scale_masses(run: Run, listener: Listener) -> None:
                             f"{MOST_MASS_FACTOR:g}, and the run would follow another, far heavier structure; ask "
                             f"for a step of at most {run.dt * MOST_MASS_FACTOR ** 0.5:.3g}")
     run.sim.mass_factor = factor
-    _update_time_step(run, listener)
+    structure = _update_time_step(run, listener)
+    if needs_calibration(run.model):  # the penalties' step and the contact nodes' masses are the scaled ones
+        s = run.sim.state
+        calibrate(run.model, s.mt, s.mr, structure)
 
 
 def _check_stability(run: Run) -> None:

@@ -123,11 +123,13 @@ def test_an_abaqus_model_comes_back_whole(tmp_path):
                                         np.linalg.norm(np.subtract(PAPILLARY, MIDDLE)),
                                         np.linalg.norm(np.subtract((4.0, 4.0, -2.0), (4.0, 3.0, surface_z(4.0))))]))
     assert tables["solver"]["method"] == "static" and tables["solver"]["end_time"] == 1.0
+    assert tables["section"]["points_through_thickness"] == 3  # the sections' 5 Simpson points
     # nothing listed but what has no counterpart
     expected = [r"8 triangle\(s\) \(first at valve_patch\.inp:\d+\): each split into three quads",
                 r"1 B31 beam element\(s\) \(first at valve_patch\.inp:\d+\).*tension only",
                 r"\*AMPLITUDE \(valve_patch\.inp:\d+\): SMOOTH STEP is brought over",
-                r"output requests \(\*OUTPUT, first at valve_patch\.inp:\d+\)"]
+                r"output requests \(\*OUTPUT, first at valve_patch\.inp:\d+\)",
+                r"\*SHELL SECTION \(valve_patch\.inp:\d+\): 5 section points become points_through_thickness = 3"]
     assert all(any(re.search(pattern, line) for line in model.unmapped) for pattern in expected), model.unmapped
     assert len(model.unmapped) == len(expected), model.unmapped
 

@@ -156,7 +156,7 @@ def test_pressure_pushes_where_abaqus_pushes_whichever_way_elements_were_numbere
     path = tmp_path / "plate.inp"
     path.write_text(strip_inp(tip_force=0.0, reversed_elements=(3,), extra_step=step).replace("_Top, SPOS", f"_Top, {face}"))
     model = read_foreign(path)
-    assert all("*OUTPUT" in line for line in model.unmapped)
+    assert all("*OUTPUT" in line or "5 section points become" in line for line in model.unmapped)
     tables = model.tables | {"geometry": {"builder": "file", "path": str(path)}, "solver": {"end_time": 1.0}}
     tables["load"] = [t for t in tables["load"] if t["type"] == "pressure"]
     assert len(tables["load"]) == 2 and {t["value"] for t in tables["load"]} == {2.0, -2.0}
@@ -585,3 +585,22 @@ def test_truss_elements_come_over_as_cables_that_stretch_as_their_law_says(tmp_p
     assert model.tables["cable"][0]["area"] == pytest.approx(np.pi * 0.16)
     assert any(re.search(r"1 B31 beam element\(s\) \(first at beam\.inp:\d+\).*tension only", line)
                for line in model.unmapped)
+
+
+def test_notes_of_one_kind_are_said_once_and_a_soft_contact_is_listed_with_its_constants(tmp_path):
+    """Five *BOUNDARY, OP=NEW in the step give one note with their count and first three
+    places; a surface interaction's linear pressure-overclosure and contact damping are
+    listed with their constants, not dropped."""
+    interaction = ("*Surface Interaction, name=Soft\n*Friction\n0.01\n"
+                   "*Surface Behavior, pressure-overclosure=LINEAR\n1000.\n*Contact Damping, definition=DAMPING COEFFICIENT\n0.1")
+    step = "\n".join(["*Boundary, op=NEW\nStrip-1.Root, ENCASTRE"] * 5
+                     + ["*Contact\n*Contact Inclusions, all exterior\n*Contact Property Assignment\n, , Soft"])
+    path = tmp_path / "strip.inp"
+    path.write_text(strip_inp(extra_model=interaction, extra_step=step))
+    notes = read_foreign(path).unmapped
+    op_new = [line for line in notes if "OP=NEW" in line]
+    assert len(op_new) == 1 and re.match(r"\*BOUNDARY \(5 times: strip\.inp:\d+, strip\.inp:\d+, strip\.inp:\d+, "
+                                         r"\.\.\.\): OP=NEW", op_new[0]), op_new
+    assert any(re.match(r"\*SURFACE BEHAVIOR \(strip\.inp:\d+\): PRESSURE-OVERCLOSURE=LINEAR \(1000\.\) is not carried",
+                        line) for line in notes), notes
+    assert any(line.startswith("*CONTACT DAMPING") for line in notes), notes

@@ -5,7 +5,8 @@ A reader is one module and one line in :data:`READERS` (file suffix -> reader)."
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from ..errors import MeshError
@@ -44,7 +45,7 @@ def read_foreign(path: Path) -> ForeignModel:
         raise MeshError(f"'{path}' is not a model file shellsim reads (suffixes: {', '.join(sorted(READERS))})")
     check_model_file(Path(path))
     try:
-        return reader(Path(path))
+        model = reader(Path(path))
     except (ValueError, IndexError) as error:  # a number that is not one, a data line cut short
         raise MeshError(f"model file '{path}' holds a value shellsim cannot read ({error}): a number that is not a "
                         "number, or a data line with fields missing") from None
@@ -52,6 +53,32 @@ def read_foreign(path: Path) -> ForeignModel:
         raise MeshError(f"model file '{path}' ({Path(path).stat().st_size / 1e6:,.0f} MB) does not fit in the memory "
                         "this process may use to read it; read it on a machine with more memory, or split its "
                         "mesh out") from None
+    return replace(model, unmapped=grouped(model.unmapped))
+
+
+#: A note's place in the file: '(name.inp:123)' after the keyword it is about.
+_PLACE = re.compile(r" \(([^()]+:\d+)\)")
+#: The places a grouped note shows before '...'.
+SHOWN_PLACES = 3
+
+
+def grouped(notes: list[str]) -> list[str]:
+    """The notes with those that differ only in their place in the file said once, with
+    their count and first places: '*BOUNDARY (276 times: leaflet.inp:12, :40, :58, ...):
+    OP=NEW ...'; in the order each first comes."""
+    places: dict[str, list[str]] = {}
+    for note in notes:
+        found = _PLACE.search(note)
+        key = note if found is None else note[:found.start()] + " ({})" + note[found.end():]
+        places.setdefault(key, []).append(found.group(1) if found else "")
+    out = []
+    for key, where in places.items():
+        if len(where) == 1 or not where[0]:
+            out += [key.replace("({})", f"({w})") for w in where] if where[0] else [key] * len(where)
+            continue
+        shown = ", ".join(where[:SHOWN_PLACES]) + (", ..." if len(where) > SHOWN_PLACES else "")
+        out.append(key.replace("({})", f"({len(where)} times: {shown})"))
+    return out
 
 
 def check_model_file(path: Path) -> None:

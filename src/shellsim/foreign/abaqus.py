@@ -158,6 +158,7 @@ class _Builder:
         covered = np.zeros(len(self.shells.conn), dtype=bool)
         thickness = np.full(len(self.shells.conn), np.nan)
         parts: dict[tuple[str, str], tuple[Keyword, str, list[str]]] = {}  # (material, orientation) -> section, prefix, sets
+        section_points: list[tuple[int, Keyword]] = []
         cables = []
         for k, elset, prefix in m.sections:
             elements = self.shells.elements_of(m.elsets[elset].items)
@@ -175,6 +176,8 @@ class _Builder:
                 continue
             covered[elements] = True
             thickness[elements] = float(k.rows[0][0])
+            if len(k.rows[0]) > 1 and k.rows[0][1].strip().isdigit():
+                section_points.append((int(k.rows[0][1]), k))
             part = ((k.param("material") or "").lower(), (k.param("orientation") or "").lower())
             parts.setdefault(part, (k, prefix, []))[2].append(self.shells.set_of[("elset", elset)])
             offset = (k.param("offset") or "0").upper()
@@ -198,6 +201,8 @@ class _Builder:
             np.add.at(total, self.shells.conn, thickness[:, None])
             np.add.at(count, self.shells.conn, 1.0)
             self.shells.thickness = total / np.maximum(count, 1.0)  # a cable's own node: 0
+        if section_points:
+            section["points_through_thickness"] = self._points_through_thickness(section_points)
         materials = self._materials(parts)
         if materials:
             if any(t["model"] != "linear_elastic" for t in materials) or "nlgeom" in self._step_params():
@@ -277,6 +282,17 @@ class _Builder:
     def _step_params(self) -> dict[str, str]:
         step = self.model.steps[0][0].params if self.model.steps else {}
         return {k: v for k, v in step.items() if not (k == "nlgeom" and v.upper() in ("NO", "OFF"))}
+
+    def _points_through_thickness(self, section_points: list[tuple[int, Keyword]]) -> int:
+        """The Gauss points through the thickness for the sections' own section points: as
+        many up to 3; more (Abaqus' Simpson points, 5 by default) become 3, listed: the 3
+        Gauss points integrate a polynomial of degree 5 through the thickness exactly, 5
+        Simpson points one of degree 3."""
+        count, k = max(section_points, key=lambda pk: pk[0])
+        if count > 3:
+            self.model.unmapped.append(f"{k.label()}: {count} section points become points_through_thickness = 3 "
+                                       "(Gauss: exact through the thickness to degree 5, Simpson's 5 points to 3)")
+        return min(count, 3)
 
     def _materials(self, parts: dict[tuple[str, str], tuple[Keyword, str, list[str]]]) -> list[dict]:
         """A material table for each (material, orientation) of the shell sections, naming
@@ -676,6 +692,23 @@ class _Builder:
                 contacts.append(entry | ({"friction": friction} if friction else {}))
         if contacts:
             self.tables["contact"] = contacts
+            for options in m.interactions.values():
+                self._interaction_notes(options)
+
+    def _interaction_notes(self, options: list[Keyword]) -> None:
+        """List what a surface interaction says beyond its friction: a softened pressure-
+        overclosure (with its constants) and contact damping."""
+        for k in options:
+            overclosure = (k.param("pressure-overclosure") or "hard").lower()
+            if k.name == "surface behavior" and overclosure != "hard":
+                constants = ", ".join(v for row in k.rows for v in row)
+                self.model.unmapped.append(
+                    f"{k.label()}: PRESSURE-OVERCLOSURE={overclosure.upper()} ({constants or 'no constants'}) is not "
+                    "carried: shellsim's contact is a penalty scaled to each node's critical-step spring "
+                    "(contact.penalty, 0.1 by default: stiff, near HARD); the contact stays with that")
+            elif k.name == "contact damping":
+                self.model.unmapped.append(f"{k.label()}: *CONTACT DAMPING is not carried (shellsim's contact has no "
+                                           "damping of its own)")
 
     @staticmethod
     def _friction(options: list[Keyword]) -> float:

@@ -229,7 +229,7 @@ def membrane_patch(model):
 def uniform_plane_stress(model, stress):
     """The stress is the plane-stress law applied to STRAIN at every point (compared by the
     invariants of the in-plane stress: the lamina axes need not be x, y)."""
-    expected = model.material.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
+    expected = model.material.C[0] @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     s11, s22, s12 = stress[..., 0], stress[..., 1], stress[..., 2]
     np.testing.assert_allclose(s11 + s22, expected[0] + expected[1], rtol=1e-5)
     np.testing.assert_allclose(s11 * s22 - s12**2, expected[0] * expected[1] - expected[2] ** 2, rtol=1e-5)
@@ -253,7 +253,7 @@ def test_point_tensors_are_the_plane_stress_law_and_the_exact_strain_in_global_a
     R = rotation(np.array([0.0, 0.0, 1.0]), turn)
     x, d = (model.x0 + model.x0 @ STRAIN.T) @ R.T, model.d0 @ R.T
     _, _, stress = internal(model, x, d, model.e1f0 @ R.T)
-    law = model.material.C @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
+    law = model.material.C[0] @ np.array([STRAIN[0, 0], STRAIN[1, 1], 2 * STRAIN[0, 1], 0.0, 0.0])
     sigma = np.array([[law[0], law[2], 0.0], [law[2], law[1], 0.0], [0.0, 0.0, 0.0]])
     out = [np.empty((model.n_elements, 9, len(model.rule.tz), 3, 3)) for _ in range(3)]
     point_tensors((x, d, model.h0), model.conn, (model.rule.N[:9], model.rule.dNr[:9], model.rule.dNs[:9], model.rule.tz),
@@ -320,7 +320,7 @@ def test_lumped_masses_add_up_and_are_positive(curved, mass):
     model = curved
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    lumped_masses(model.rule, model.body, initial_shape(model), 7.0, mass == "M1", mt, mr)
+    lumped_masses(model.rule, model.body, initial_shape(model), np.full(model.n_elements, 7.0), mass == "M1", mt, mr)
     volume = np.sum(1.0 / np.abs(np.linalg.det(model.body.jac0_inv[:, :9])) * model.rule.wq[None, :, None] * model.rule.wt[None, None, :])
     assert mt.sum() == pytest.approx(7.0 * volume, rel=1e-12)
     assert np.all(mt > 0) and np.all(mr > 0)
@@ -330,7 +330,7 @@ def test_m2_masses_of_a_rectangle_are_the_tensor_product_of_simpson_weights():
     _, model = make_model('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', "divisions = { length = 1, width = 1 }")
     n = model.n_nodes
     mt, mr = np.zeros(n), np.zeros(n)
-    lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
+    lumped_masses(model.rule, model.body, initial_shape(model), np.ones(model.n_elements), False, mt, mr)
     total = 2.0 * 1.0 * T
     np.testing.assert_allclose(mt[model.conn[0]], total * np.array([1, 1, 1, 1, 4, 4, 4, 4, 16]) / 36, rtol=1e-12)
     np.testing.assert_allclose(mr / mt, T**2 / 12, rtol=1e-12)  # director inertia of the fibre
@@ -510,7 +510,7 @@ def test_m2_rotary_inertia_does_not_depend_on_the_thickness_rule():
                               material=('model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
                                         f"points_through_thickness = {points}"))
         mt, mr = np.empty(model.n_nodes), np.empty(model.n_nodes)
-        lumped_masses(model.rule, model.body, initial_shape(model), 1.0, False, mt, mr)
+        lumped_masses(model.rule, model.body, initial_shape(model), np.ones(model.n_elements), False, mt, mr)
         masses.append(mr)
     assert masses[1].min() > 0.0
     np.testing.assert_allclose(masses[0], masses[1], rtol=1e-12)

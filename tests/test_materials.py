@@ -202,7 +202,7 @@ def _fibre_law(case: str, beta_deg: float):
     """(kernels' Material, closed-form Cauchy stress) of a :data:`FIBRE_LAWS` case."""
     model, params, cauchy = FIBRE_LAWS[case]
     beta = np.radians(beta_deg)
-    return material(model)._replace(params=np.array(params(np.cos(beta), np.sin(beta)), dtype=float)), cauchy
+    return material(model)._replace(params=np.array([params(np.cos(beta), np.sin(beta))], dtype=float)), cauchy
 
 
 def _stretched(mat: Material, l1: float, l2: float):
@@ -223,11 +223,12 @@ def test_fibre_laws_homogeneous_stretches_match_the_closed_form(case, beta_deg, 
     from scipy.optimize import brentq
 
     mat, cauchy = _fibre_law(case, beta_deg)
-    lateral = brentq(lambda l2: cauchy(mat.params, stretch, l2)[1], 0.3, 1.5, xtol=1e-15, rtol=1e-15)
+    params = mat.params[0]  # the one part's
+    lateral = brentq(lambda l2: cauchy(params, stretch, l2)[1], 0.3, 1.5, xtol=1e-15, rtol=1e-15)
     for l1, l2 in ((stretch, stretch), (stretch, lateral)):
         S, E = _stretched(mat, l1, l2)
-        s11, s22, s12 = cauchy(mat.params, l1, l2)
-        scale = max(abs(s11), abs(s22), mat.params[0])
+        s11, s22, s12 = cauchy(params, l1, l2)
+        scale = max(abs(s11), abs(s22), params[0])
         np.testing.assert_allclose(S[0, 0], s11 / l1**2, rtol=1e-9, atol=1e-12 * scale)
         np.testing.assert_allclose(S[1, 1], s22 / l2**2, rtol=1e-9, atol=1e-9 * scale)
         np.testing.assert_allclose(S[0, 1], s12 / (l1 * l2), rtol=1e-9, atol=1e-12 * scale)
@@ -243,9 +244,9 @@ def test_fibres_in_compression_carry_nothing(case):
     l1 = 0.9
     S, _ = _stretched(mat, l1, 1.0)
     if case.startswith("hgo"):
-        np.testing.assert_allclose(S[0, 0], mat.params[0] * (l1**2 - l1**-2) / l1**2, rtol=1e-12)
+        np.testing.assert_allclose(S[0, 0], mat.params[0, 0] * (l1**2 - l1**-2) / l1**2, rtol=1e-12)
     else:
-        c0, c1, c2, _, delta = mat.params[:5]
+        c0, c1, c2, _, delta = mat.params[0, :5]
         i1 = l1**2 + 1 + l1**-2 - 3
         W1 = c0 / 2 + c1 * delta * c2 * i1 * np.exp(c2 * i1**2)
         np.testing.assert_allclose(S[0, 0], 2 * W1 * (l1**2 - l1**-2) / l1**2, rtol=1e-12)

@@ -255,29 +255,11 @@ class _Builder:
             if "neo hooke" in k.params and row:
                 return {"model": "neo_hookean", "mu": 2.0 * row[0]}
             if "ogden" in k.params:
-                return _Builder._ogden(k)
+                return ogden_law(k)
             return None
         if "elastic" in by_name and by_name["elastic"].rows:
             return {"model": "linear", "E": float(by_name["elastic"].rows[0][0])}
         return None
-
-    @staticmethod
-    def _ogden(k: Keyword) -> dict | None:
-        """An ``*HYPERELASTIC, OGDEN, N=n`` law (n <= 6): its data lines hold mu_1, alpha_1,
-        ..., mu_n, alpha_n, then the compressibilities D_i (an incompressible chord takes
-        none); None where it does not fit :class:`~shellsim.loads.cable_laws.Ogden`."""
-        try:
-            terms = int(k.param("n") or 1)
-            values = [float(v) for row in k.rows for v in row if str(v).strip()]
-        except ValueError:
-            return None
-        if not 1 <= terms <= OGDEN_TERMS or len(values) < 2 * terms:
-            return None
-        mu, alpha = values[0:2 * terms:2], values[1:2 * terms:2]
-        if not all(m * a > 0.0 for m, a in zip(mu, alpha)):
-            return None
-        return {"model": "ogden", "mu": mu[0], "alpha": alpha[0]} if terms == 1 else {"model": "ogden", "mu": mu,
-                                                                                        "alpha": alpha}
 
     def _step_params(self) -> dict[str, str]:
         step = self.model.steps[0][0].params if self.model.steps else {}
@@ -757,3 +739,21 @@ def _is_number(text: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def ogden_law(k: Keyword) -> dict | None:
+    """An ``*HYPERELASTIC, OGDEN, N=n`` law (n <= 6): its data lines hold mu_1, alpha_1,
+    ..., mu_n, alpha_n, then the compressibilities D_i (an incompressible chord takes
+    none); None where it does not fit :class:`~shellsim.loads.cable_laws.Ogden`."""
+    try:
+        terms = int(k.param("n") or 1)
+        values = [float(v) for row in k.rows for v in row if str(v).strip()]
+    except ValueError:
+        return None
+    if not 1 <= terms <= OGDEN_TERMS or len(values) < 2 * terms:
+        return None
+    mu, alpha = values[0:2 * terms:2], values[1:2 * terms:2]
+    if not all(m * a > 0.0 for m, a in zip(mu, alpha)):
+        return None
+    return {"model": "ogden", "mu": mu[0], "alpha": alpha[0]} if terms == 1 else {"model": "ogden", "mu": mu,
+                                                                                    "alpha": alpha}

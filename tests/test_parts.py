@@ -180,3 +180,17 @@ def test_a_misspelt_key_of_one_part_s_table_is_named_with_its_part():
         "[material]", '[[material]]\nsets = ["all"]').replace("nu = 0.3", "nu = 0.3\nEE = 3.0")
     assert "material[0].EE (line 10): unknown key 'EE'; did you mean 'E'?; keys here: sets, model, E, nu, density" \
         in problems_of(text)
+
+
+def test_one_material_split_into_parts_of_its_constants_is_the_same_scene(tmp_path):
+    """The side-by-side pull with one material, and with that material written as two
+    parts of the same constants: every position and director the same to the last bit
+    (the parts' groups differ; the sums at the nodes are taken in one order)."""
+    path = halves(tmp_path, "y")
+    one = LINEAR.format("first", 1000.0).replace('sets = ["first"]\n', "").replace("[[material]]", "[material]")
+    parts = LINEAR.format("first", 1000.0) + LINEAR.format("second", 1000.0)
+    whole, split = (run_deck(parse_deck(pulled(path, text.replace("nu = 0.0", "nu = 0.3"), 1.001)))
+                    for text in (one, parts))
+    assert np.array_equal(whole.sim.state.x, split.sim.state.x)
+    assert np.array_equal(whole.sim.state.d, split.sim.state.d)
+    assert set(split.model.body.part) == {0, 1} and set(whole.model.body.part) == {0}

@@ -261,3 +261,24 @@ def test_every_deck_model_of_a_law_is_a_deck_material():
     for law in LAWS:
         for model in law.MODELS:
             assert MATERIALS[tag_of(model)[1]] is model
+
+
+@pytest.mark.parametrize("delta", [1.0, 0.5])
+def test_an_isotropic_lee_sacks_law_is_not_refused_axes_it_does_not_need(delta):
+    """Lee-Sacks at delta = 1 has no fibre term: fixed axes along the plate's normal, which
+    cannot be laid in it, leave the elements' own directions (its stress takes none); at
+    delta = 0.5 the fibres need them, and the axis is refused naming it."""
+    from shellsim.deck import parse_deck
+    from shellsim.errors import MeshError
+
+    from .conftest import deck_text, prepared
+
+    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0').replace(
+        'model = "linear_elastic"\nE = 1000.0\nnu = 0.3',
+        f'model = "lee_sacks"\nc0 = 10.0\nc1 = 2.0\nc2 = 4.0\nc3 = 20.0\ndelta = {delta}\n'
+        'axes = { kind = "fixed", direction = [0.0, 0.0, 1.0] }')
+    if delta == 1.0:
+        assert prepared(parse_deck(text)).model.material.law[0] == law_of("lee_sacks")[0]
+    else:
+        with pytest.raises(MeshError, match="direction = \\(0, 0, 1\\) lies along the shell's normal"):
+            prepared(parse_deck(text))

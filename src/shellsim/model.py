@@ -155,14 +155,28 @@ def _material(deck: Deck, mesh: Mesh, rule: Rule, part: np.ndarray) -> Material:
     axes0 = np.empty((mesh.n_elements, nq, len(rule.tz), 3, 3))
     for i, m in enumerate(materials):
         elements = np.flatnonzero(part == i)
-        axes0[elements] = material_frames(mesh, getattr(m, "axes", None), rule.N[:nq], rule.dNr[:nq],
-                                          rule.dNs[:nq], rule.tz, elements)
+        axes0[elements] = _frames_of(m, mesh, rule, elements)
     energy_stress, energy_tangent = held_laws([code for code, _ in laws])
     return Material(path=HYPERELASTIC, incremental=False, push_forward=False, thickness_update=deck.thickness_update,
                     law=np.array([code for code, _ in laws], dtype=np.int64), energy_stress=energy_stress,
                     energy_tangent=energy_tangent, params=padded,
                     incompressible=np.array([law.INCOMPRESSIBLE for _, law in laws]), axes0=axes0,
                     C=np.zeros((count, 5, 5)), normal_ratio=np.zeros(count))
+
+
+def _frames_of(material, mesh: Mesh, rule: Rule, elements: np.ndarray) -> np.ndarray:
+    """The initial material frames of ``material``'s ``elements``: of its axes, or, where a
+    law its constants make isotropic cannot lay them (a mesh field missing, an axis along
+    a normal), of the elements' own directions, which its stress does not depend on."""
+    nq = len(rule.wq)
+    frames = lambda axes: material_frames(mesh, axes, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz,  # noqa: E731
+                                          elements)
+    try:
+        return frames(getattr(material, "axes", None))
+    except MeshError:
+        if not getattr(material, "isotropic", False):
+            raise
+        return frames(None)
 
 
 def material_frames(mesh: Mesh, axes, N, dNr, dNs, tz, elements: np.ndarray | None = None) -> np.ndarray:

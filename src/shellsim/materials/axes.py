@@ -136,10 +136,19 @@ def _nonzero_vector(v: tuple[float, float, float]) -> tuple[float, float, float]
 
 class AnisotropicLaw(MaterialTable):
     """The base of an anisotropic hyperelastic law's ``[material]`` table, which declares
-    ``axes: Axes`` among its own fields: cylindrical axes when the deck gives none."""
+    ``axes: Axes`` among its own fields: cylindrical axes when the deck gives none. Its
+    :attr:`isotropic` says where the constants leave the law no direction (Lee-Sacks at
+    delta = 1): axes that cannot be laid (a mesh field missing, an axis along a normal)
+    are then not demanded."""
 
     HYPERELASTIC: ClassVar[bool] = True
     ANISOTROPIC: ClassVar[bool] = True
+
+    @property
+    def isotropic(self) -> bool:
+        """Whether these constants make the law isotropic (no fibre term); False unless
+        the law says."""
+        return False
 
     @model_validator(mode="before")
     @classmethod

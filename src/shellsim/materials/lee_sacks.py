@@ -48,6 +48,11 @@ class LeeSacks(AnisotropicLaw):
     density: Positive
     axes: Axes
 
+    @property
+    def isotropic(self) -> bool:
+        """delta = 1 leaves no fibre term: W = c0/2 (I1 - 3) + c1/2 (exp(c2 (I1 - 3)^2) - 1)."""
+        return self.delta == 1.0
+
 
 INCOMPRESSIBLE = True
 #: The deck's material models this law serves.

@@ -181,3 +181,38 @@ def test_each_section_s_material_comes_over_as_a_part_of_its_own(tmp_path):
     said = " ".join(checked.output.replace("│", " ").split())
     assert checked.exit_code == 0, checked.output
     assert "hgo (" in said and "on 'Patch-1_Belly'" in said and "neo_hookean (C1=0.5, density=1.3e-09) on 'Patch-1_Edge'" in said
+
+
+def test_user_materials_come_over_by_one_mapping_each_with_its_constants(tmp_path):
+    """Both leaflet sections' materials are user materials of one law, W = C0/2 (I1 - 3)
+    + C1/2 (exp(C2 (I1 - 3)^2) - 1), with their own constants: one --user-material
+    mapping (Lee-Sacks at delta = 1) brings each over as its own [[material]] table with
+    its constants and density, and ``check`` accepts the deck; without it each is listed
+    with its constants and the option to use; a mapping that does not read is refused."""
+    from typer.testing import CliRunner
+
+    from shellsim.cli import app
+
+    path = tmp_path / "valve_patch.inp"
+    path.write_text(abaqus_model()
+                    .replace("*Anisotropic Hyperelastic, holzapfel, local directions=2\n0.025, 0., 0.2, 3., 0.1",
+                             "*User Material, constants=3\n0.0676, 0.0133, 38.19")
+                    .replace("*Shell Section, elset=Edge, material=Leaflet", "*Shell Section, elset=Edge, material=Edge")
+                    + "*Material, name=Edge\n*Density\n1.3e-9\n*User Material, constants=3\n0.05, 0.02, 14.86\n")
+    mapping = "lee_sacks: c0 = $1, c1 = $2, c2 = $3, c3 = 0, delta = 1"
+    runner = CliRunner()
+    result = runner.invoke(app, ["import", str(path), "--out", str(tmp_path / "deck"), "--user-material", mapping])
+    assert result.exit_code == 0, result.output
+    from shellsim.deck import load_deck
+
+    deck = load_deck(tmp_path / "deck" / "deck.toml")
+    laws = [(m.sets, m.model, m.c0, m.c1, m.c2, m.c3, m.delta, m.density) for m in deck.material]
+    assert laws == [(["Patch-1_Belly"], "lee_sacks", 0.0676, 0.0133, 38.19, 0.0, 1.0, 1.1e-9),
+                    (["Patch-1_Edge"], "lee_sacks", 0.05, 0.02, 14.86, 0.0, 1.0, 1.3e-9)]
+    assert runner.invoke(app, ["check", str(tmp_path / "deck" / "deck.toml")]).exit_code == 0
+    notes = read_foreign(path).unmapped
+    assert any(re.search(r"user material 'Edge' \(constants 0\.05, 0\.02, 14\.86\): map its law with shellsim import "
+                         r"--user-material", line) for line in notes), notes
+    refused = runner.invoke(app, ["import", str(path), "--out", str(tmp_path / "other"), "--user-material",
+                                  "lee_sacks: c0 = first"])
+    assert refused.exit_code == 2 and "--user-material" in refused.output and "Traceback" not in refused.output

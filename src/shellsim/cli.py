@@ -204,19 +204,26 @@ def mesh(
 @app.command("import")
 @reports_errors
 def import_model(
-    model: Annotated[Path, typer.Argument(help="Model file: Abaqus input (.inp).", show_default=False)],
+    model: Annotated[Path, typer.Argument(help="Model file: Abaqus input (.inp) or FEBio (.feb).",
+                                          show_default=False)],
     out_dir: Annotated[Path | None, typer.Option("--out", help="Folder for deck.toml and the mesh [default: the "
                                                               "model's name].")] = None,
+    user_material: Annotated[str | None, typer.Option(
+        "--user-material", help="The law of the file's user materials, each with its own constants: 'MODEL: KEY = "
+                                "$n | number, ...' ($n: the n-th constant), e.g. 'lee_sacks: c0 = $1, c1 = $2, "
+                                "c2 = $3, c3 = 0, delta = 1'.")] = None,
 ) -> None:
     """Bring a model made with another program over as an editable deck and its mesh:
     shells as 9-node quads with their sets and material axes, and the material, section,
     supports, loads, contact, amplitudes and first step as deck tables. What has no
     counterpart is listed (and written at the top of the deck), never dropped silently."""
+    from .foreign.user_law import UserLaw
     from .imported_deck import import_model as bring_over
 
+    user_law = UserLaw.parse(user_material) if user_material is not None else None
     folder = output_folder(out_dir or Path(model.stem))
     with err.status(f"reading {model}"):
-        done = bring_over(model, folder)
+        done = bring_over(model, folder, user_law)
     sets = ", ".join(f"{name} ({kind})" for name, kind in sorted(done.sets.items()))
     cables = f", {done.cables} cable elements" if done.cables else ""
     out.print(f"{shown(str(model))}: {done.elements} elements{cables}; sets: {shown(sets) or 'none'}",

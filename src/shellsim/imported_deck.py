@@ -36,8 +36,9 @@ class Imported:
     problems: list[str]
 
 
-def import_model(source: Path, folder: Path) -> Imported:
-    """Bring the model ``source`` over into ``folder`` as DECK_NAME and ``<stem>.vtu``.
+def import_model(source: Path, folder: Path, user_law=None) -> Imported:
+    """Bring the model ``source`` over into ``folder`` as DECK_NAME and ``<stem>.vtu``, its
+    user materials mapped by ``user_law`` (:class:`shellsim.foreign.user_law.UserLaw`).
 
     Refuses (OutputError) to replace a deck already in ``folder``; MeshError for a model
     that cannot be read. The deck is validated and its sets checked against the mesh; its
@@ -48,7 +49,7 @@ def import_model(source: Path, folder: Path) -> Imported:
     deck_path, mesh_path = folder / DECK_NAME, folder / f"{source.stem}.vtu"
     if deck_path.exists():
         raise OutputError(f"'{deck_path}' exists: import into another folder (--out) or move it away first")
-    model = read_foreign(source)
+    model = read_foreign(source, user_law)
     output_folder(folder)
     m = model.mesh
     thickness = m.thickness if m.thickness is not None else np.full(len(m.x), model.tables["section"]["thickness"])

@@ -38,14 +38,15 @@ def meta_table(path: Path, title: str) -> dict:
     return {"title": title, "description": f"Brought over from {path.name}", "source": path.name}
 
 
-def read_foreign(path: Path) -> ForeignModel:
-    """The model in ``path``, read by the reader of its suffix; MeshError for another file."""
+def read_foreign(path: Path, user_law=None) -> ForeignModel:
+    """The model in ``path``, read by the reader of its suffix; MeshError for another file.
+    ``user_law`` (:class:`.user_law.UserLaw`) maps its user materials onto a law."""
     reader = READERS.get(Path(path).suffix.lower())
     if reader is None:
         raise MeshError(f"'{path}' is not a model file shellsim reads (suffixes: {', '.join(sorted(READERS))})")
     check_model_file(Path(path))
     try:
-        model = reader(Path(path))
+        model = reader(Path(path), user_law)
     except (ValueError, IndexError) as error:  # a number that is not one, a data line cut short
         raise MeshError(f"model file '{path}' holds a value shellsim cannot read ({error}): a number that is not a "
                         "number, or a data line with fields missing") from None
@@ -99,13 +100,14 @@ def read_foreign_mesh(path: Path) -> ImportedMesh:
     return model.mesh
 
 
-def _abaqus(path: Path) -> ForeignModel:
+def _abaqus(path: Path, user_law) -> ForeignModel:
     from .abaqus import read_abaqus
 
-    return read_abaqus(path)
+    return read_abaqus(path, user_law)
 
 
-def _febio(path: Path) -> ForeignModel:
+def _febio(path: Path, user_law) -> ForeignModel:
+    """FEBio's materials are its own types: no user law to map."""
     from .febio import read_febio
 
     return read_febio(path)

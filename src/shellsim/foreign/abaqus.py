@@ -27,6 +27,7 @@ from . import ForeignModel, meta_table
 from .abaqus_model import OUTPUT_REQUESTS, AbaqusModel, Keyword, qualified, read_model
 from .deck_tables import AXES, pressure_loads, support_table
 from .shell_mesh import ShellMesh, deck_name, listed
+from .user_law import UserLaw
 
 #: Abaqus shell types by their number of nodes.
 SHELLS = {3: {"S3", "S3R", "S3RS", "STRI3"}, 4: {"S4", "S4R", "S4R5", "S4RS", "S4RSW"}, 8: {"S8R", "S8R5"},
@@ -46,10 +47,11 @@ BOUNDARY_TYPES = {"encastre": {1, 2, 3, 4, 5, 6}, "pinned": {1, 2, 3}, "xsymm": 
                   "zsymm": {3, 4, 5}, "xasymm": {2, 3, 4}, "yasymm": {1, 3, 5}, "zasymm": {1, 2, 6}}
 
 
-def read_abaqus(path: Path) -> ForeignModel:
-    """The model of the Abaqus input file ``path``; MeshError for one without usable shells."""
+def read_abaqus(path: Path, user_law: UserLaw | None = None) -> ForeignModel:
+    """The model of the Abaqus input file ``path``, its user materials mapped by
+    ``user_law`` (left out, listed, without); MeshError for one without usable shells."""
     model = read_model(path)
-    builder = _Builder(model)
+    builder = _Builder(model, user_law)
     builder.mesh()
     builder.material_and_section()
     builder.curves_of_amplitudes()
@@ -64,8 +66,9 @@ class _Builder:
     """Maps a flattened :class:`AbaqusModel` piece by piece; the pieces share the mesh and
     the set names made so far."""
 
-    def __init__(self, model: AbaqusModel):
+    def __init__(self, model: AbaqusModel, user_law: UserLaw | None = None):
         self.model = model
+        self.user_law = user_law
         self.tables: dict = {}
         self.unused_elements: list[str] = []
         self.curve_of: dict[str, str] = {}  # amplitude key -> curve name
@@ -306,10 +309,15 @@ class _Builder:
         by_name.pop("depvar", None)
         table: dict | None = None
         if user is not None:
-            constants = ", ".join(v for row in user.rows for v in row)
-            m.unmapped.append(f"{user.label()}: user material '{name}' (constants {constants}): name the law in "
-                              "[material] instead, e.g. model = 'lee_sacks' (c0, c1, c2, c3, delta) for leaflets or "
-                              "'hgo' for arteries (docs/decks.md)")
+            constants = [v for row in user.rows for v in row if v.strip()]
+            table = self.user_law.table([float(v) for v in constants]) if self.user_law is not None else None
+            if table is None:
+                m.unmapped.append(
+                    f"{user.label()}: user material '{name}' (constants {', '.join(constants)}): "
+                    + ("the --user-material mapping names more constants than it has" if self.user_law is not None
+                       else "map its law with shellsim import --user-material 'MODEL: KEY = $n, ...' (e.g. "
+                            "'lee_sacks: c0 = $1, c1 = $2, c2 = $3, c3 = 0, delta = 1'), or name it in [material]; "
+                            "docs/import.md"))
         elif "anisotropic hyperelastic" in by_name:
             table = self._holzapfel(by_name.pop("anisotropic hyperelastic"), section, prefix)
         elif "hyperelastic" in by_name:

@@ -150,6 +150,24 @@ set = "all"
 """)
 
 
+#: A rectangle strip on rollers along its edges x0 and y0 and held in its plane z = 0
+#: (the builder's sets): free to stretch and contract in its plane.
+ROLLERS = """
+[[boundary]]
+type = "symmetry"
+set = "x0"
+normal = [1.0, 0.0, 0.0]
+[[boundary]]
+type = "symmetry"
+set = "y0"
+normal = [0.0, 1.0, 0.0]
+[[boundary]]
+type = "fixed"
+set = "all"
+translations = ["z"]
+"""
+
+
 def deck_text(geometry: str, extra: str = "", base: str = BASE) -> str:
     """A valid deck: ``base`` + [geometry] body + extra tables."""
     return f"{base}\n[geometry]\n{geometry}\n{extra}"

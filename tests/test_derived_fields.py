@@ -14,7 +14,7 @@ from shellsim.output.encoding import symmetric_tensors
 from shellsim.output.fields import frame_fields, output_mesh
 from shellsim.measures.probes import probe_value, resolve_probes
 
-from .conftest import BASE, ROOT, deck_text, prepared, problems_of, run_deck
+from .conftest import BASE, ROLLERS, ROOT, deck_text, prepared, problems_of, run_deck
 
 TEST9 = ROOT / "decks" / "verification" / "test09_aorta_static.toml"
 DERIVED = ["cauchy_stress", "pressure_band", "principal_stress", "vessel_stress", "fibre_stretch"]
@@ -186,18 +186,7 @@ def test_an_incompressible_strip_pulled_to_a_stretch_thins_to_its_inverse_root()
     text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 0.5', f'''
 [mesh]
 divisions = {{ length = 2, width = 2 }}
-[[boundary]]
-type = "symmetry"
-set = "x0"
-normal = [1.0, 0.0, 0.0]
-[[boundary]]
-type = "symmetry"
-set = "y0"
-normal = [0.0, 1.0, 0.0]
-[[boundary]]
-type = "fixed"
-set = "all"
-translations = ["z"]
+{ROLLERS}
 [[boundary]]
 type = "prescribed"
 set = "x1"

@@ -17,7 +17,7 @@ from shellsim.geometry import build_mesh
 from shellsim.mesh import NamedSet
 from shellsim.output.mesh_files import write_mesh_vtu
 
-from .conftest import deck_text, prepared, problems_of, run_deck
+from .conftest import ROLLERS, deck_text, prepared, problems_of, run_deck
 
 LENGTH, WIDTH, THICKNESS = 2.0, 1.0, 0.01
 
@@ -54,22 +54,7 @@ thickness = {THICKNESS}
 [geometry]
 builder = "file"
 path = "{path.as_posix()}"
-
-[[boundary]]
-type = "symmetry"
-set = "x0"
-normal = [1.0, 0.0, 0.0]
-
-[[boundary]]
-type = "symmetry"
-set = "y0"
-normal = [0.0, 1.0, 0.0]
-
-[[boundary]]
-type = "fixed"
-set = "all"
-translations = ["z"]
-
+{ROLLERS}
 [[boundary]]
 type = "prescribed"
 set = "x1"

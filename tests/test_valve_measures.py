@@ -14,7 +14,7 @@ from shellsim.deck import parse_deck
 from shellsim.mesh import NamedSet
 from shellsim.measures.valve import Valve, fill_triangles, largest_principal, resolve_valve
 
-from .conftest import PLATE_THICKNESS, deck_text, pressed_plates, prepared, problems_of, run_deck
+from .conftest import PLATE_THICKNESS, ROLLERS, deck_text, pressed_plates, prepared, problems_of, run_deck
 
 PLATE = 'builder = "rectangle"\nlength = 1.0\nwidth = 1.0'
 
@@ -109,18 +109,7 @@ def test_a_strip_in_uniaxial_tension_peaks_at_the_pulling_stress():
     deck = parse_deck(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', f'''
 [mesh]
 divisions = {{ length = 2, width = 2 }}
-[[boundary]]
-type = "symmetry"
-set = "x0"
-normal = [1.0, 0.0, 0.0]
-[[boundary]]
-type = "symmetry"
-set = "y0"
-normal = [0.0, 1.0, 0.0]
-[[boundary]]
-type = "fixed"
-set = "all"
-translations = ["z"]
+{ROLLERS}
 [[load]]
 type = "edge_pressure"
 set = "x1"

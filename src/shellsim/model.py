@@ -169,8 +169,10 @@ def _frames_of(material, mesh: Mesh, rule: Rule, elements: np.ndarray) -> np.nda
     law its constants make isotropic cannot lay them (a mesh field missing, an axis along
     a normal), of the elements' own directions, which its stress does not depend on."""
     nq = len(rule.wq)
-    frames = lambda axes: material_frames(mesh, axes, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz,  # noqa: E731
-                                          elements)
+
+    def frames(axes) -> np.ndarray:
+        return material_frames(mesh, axes, rule.N[:nq], rule.dNr[:nq], rule.dNs[:nq], rule.tz, elements)
+
     try:
         return frames(getattr(material, "axes", None))
     except MeshError:

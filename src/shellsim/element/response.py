@@ -255,6 +255,7 @@ def _stresses(steps, rule, material, group, points, scratch):
     volume-weighted in-plane parts points.SW."""
     nq, nt, share = rule.wq.shape[0], rule.tz.shape[0], rule.share
     stress, SW, DV = group.stress, points.SW, points.DV
+    C = material.C[group.part[0]]  # the group's part's, taken once
     for p in range(nq):
         if steps.hyperelastic:
             hyperelastic_layers(steps.product, material, group, points, scratch, p, share)
@@ -262,7 +263,7 @@ def _stresses(steps, rule, material, group, points, scratch):
             if steps.convected:
                 group.stretch[p, :] = 1.0
             for k in range(nt):
-                constant_tensor(material.C[group.part[0]], points.EPS[p, k], stress[p, k], steps.incremental)
+                constant_tensor(C, points.EPS[p, k], stress[p, k], steps.incremental)
                 if steps.convected:
                     convected_layer(material, group, points, scratch, p, k, share[k])
         for k in range(nt):

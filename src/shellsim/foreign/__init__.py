@@ -74,8 +74,8 @@ def grouped(notes: list[str]) -> list[str]:
         places.setdefault(key, []).append(found.group(1) if found else "")
     out = []
     for key, where in places.items():
-        if len(where) == 1 or not where[0]:
-            out += [key.replace("({})", f"({w})") for w in where] if where[0] else [key] * len(where)
+        if len(where) == 1 or not where[0]:  # said once, or a note of no place: as it was
+            out += [key.replace("({})", f"({w})") if w else key for w in where]
             continue
         shown = ", ".join(where[:SHOWN_PLACES]) + (", ..." if len(where) > SHOWN_PLACES else "")
         out.append(key.replace("({})", f"({len(where)} times: {shown})"))

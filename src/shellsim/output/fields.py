@@ -185,7 +185,8 @@ def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
             if family < len(fibres):
                 c, s = fibres[family]
                 mine = part == i
-                a0[mine] = c * frames[mine][..., 0, :] + s * frames[mine][..., 1, :]
+                own = frames[mine]
+                a0[mine] = c * own[..., 0, :] + s * own[..., 1, :]
         vectors.append(np.einsum("eqkij,eqkj->eqki", F, a0))
     return vectors
 

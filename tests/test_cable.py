@@ -224,6 +224,38 @@ def test_mass_scaling_takes_the_cables_step_to_its_target_with_the_shell_s():
     assert scaled.dt_history[1][2] == pytest.approx(target, rel=1e-3)  # to the estimate's tolerance (it was 8% short)
 
 
+def test_min_step_makes_only_the_cable_s_quicker_elements_heavier_to_it():
+    """A chord of 4 elements of length 0.25 (E = 1e6, rho = 1000: each element's own
+    step L sqrt(rho / E) = 7.9e-3): with ``min_step`` 0.02, above it, each is made heavier
+    by (0.02 / 7.9e-3)^2 = 6.4 and the cables' critical step is 0.02; with 1e-3, below it,
+    nothing changes (Abaqus' variable mass scaling TYPE=BELOW MIN). A multi-term Ogden
+    law's line in ``check`` lists its terms."""
+    from shellsim.bundles import Shape
+    from shellsim.deck import parse_deck
+    from shellsim.geometry import build_mesh
+    from shellsim.loads.cable import critical_step
+    from shellsim.model import build_model
+
+    def cables(extra: str):
+        deck = parse_deck(deck_text(PLATE, ANCHOR + cable_table('{ model = "linear", E = 1.0e6 }', (2.0, 0.5, 0.0),
+                                                                  4, extra)))
+        model = build_model(deck, build_mesh(deck))
+        return model, deck
+
+    own = 0.25 * math.sqrt(DENSITY / 1.0e6)
+    plain, _ = cables("")
+    heavy, deck = cables("min_step = 0.02")
+    light, _ = cables("min_step = 1e-3")
+    shape = Shape(x=heavy.x0, d=heavy.d0, e1=heavy.e1f0, h=heavy.h0)
+    np.testing.assert_allclose(heavy.loads.cable.density, DENSITY * (0.02 / own) ** 2, rtol=1e-12)
+    assert critical_step(shape, heavy.loads.cable) == pytest.approx(0.02, rel=1e-12)
+    assert critical_step(shape, plain.loads.cable) == pytest.approx(own, rel=1e-12)
+    np.testing.assert_array_equal(light.loads.cable.density, plain.loads.cable.density)
+    assert "made heavier" in deck.cable[0].summary
+    ogden = parse_deck(deck_text(PLATE, ANCHOR + cable_table(LAWS["ogden_three_terms"][0], (2.0, 0.5, 0.0))))
+    assert "mu=[200000, 50000, -100000], alpha=[8, 3, -2]" in ogden.cable[0].summary
+
+
 def test_the_cable_tangent_is_the_derivative_of_its_forces():
     """The couplings' blocks of a stretched, turned cable against central differences of
     its forces (the exact tangent, to the differences' truncation)."""

@@ -604,3 +604,51 @@ def test_notes_of_one_kind_are_said_once_and_a_soft_contact_is_listed_with_its_c
     assert any(re.match(r"\*SURFACE BEHAVIOR \(strip\.inp:\d+\): PRESSURE-OVERCLOSURE=LINEAR \(1000\.\) is not carried",
                         line) for line in notes), notes
     assert any(line.startswith("*CONTACT DAMPING") for line in notes), notes
+
+
+def test_a_run_of_an_imported_model_writes_the_file_s_numbers_in_every_frame(strip, tmp_path):
+    """The strip solved as imported: each frame holds ``source_element``, the file's
+    element number on each of its cells, and ``source_node``, the file's node number at
+    the points that are its corners (0 at the others), so results compare with Abaqus'
+    by number."""
+    from shellsim.output.series import StoredSeries
+
+    done = import_model(strip(), tmp_path / "imported")
+    result = CliRunner().invoke(app, ["run", str(done.deck), "--out", str(tmp_path / "out")], env={"COLUMNS": "60"})
+    assert result.exit_code == 0, result.output
+    series = StoredSeries(tmp_path / "out")
+    points, cells = series.frame(len(series.times) - 1)
+    assert sorted(set(cells["source_element"].astype(int))) == list(range(1, 21))
+    assert np.all(np.bincount(cells["source_element"].astype(int))[1:] == 9)  # 3 x 3 sub-cells each
+    numbered = points["source_node"] > 0
+    assert set(points["source_node"][numbered].astype(int)) == set(range(1, 34))
+    # the points of a number lie where the file's node is (the instance shifts the part by 5 along x)
+    file_x = {1 + i + j * 11: (5.0 + i, 0.5 * j) for j in range(3) for i in range(11)}
+    for label in (1, 17, 33):
+        at = series.points[points["source_node"] == label]
+        np.testing.assert_allclose(at[:, :2], np.tile(file_x[label], (len(at), 1)), atol=1e-12)
+
+
+def test_orientations_go_to_every_law_with_axes_and_are_listed_where_a_law_has_none(strip, tmp_path):
+    """A section's *ORIENTATION becomes the axes of a user material mapped to Lee-Sacks
+    (a law with axes), is listed for an isotropic law without axes, and an orientation of
+    no length is listed, not written."""
+    from shellsim.foreign.user_law import UserLaw
+
+    orientation = "*Orientation, name=Along\n1., 1., 0., 0., 1., 0.\n3, 0."
+    user = "*User Material, constants=3\n0.001, 0.0005, 4.57"
+    text = strip_inp(extra_model=orientation).replace("material=Steel", "material=Steel, orientation=Along")
+    law = UserLaw.parse("lee_sacks: c0 = $1, c1 = $2, c2 = $3, c3 = 0, delta = 1")
+    path = tmp_path / "strip.inp"
+    path.write_text(text.replace("*Elastic\n200000., 0.0", user))
+    model = read_foreign(path, law)
+    assert model.tables["material"]["axes"] == {"kind": "fixed", "direction": [1.0, 1.0, 0.0]}
+    path.write_text(text)
+    model = read_foreign(path)
+    assert "axes" not in model.tables["material"]
+    assert any(re.search(r"ORIENTATION=Along is not carried: the linear_elastic law has no material axes", line)
+               for line in model.unmapped), model.unmapped
+    path.write_text(text.replace("*Elastic\n200000., 0.0", user).replace("1., 1., 0., 0., 1., 0.", "0., 0., 0., 0., 1., 0."))
+    model = read_foreign(path, law)
+    assert "axes" not in model.tables["material"]
+    assert any("is (0, 0, 0), which points nowhere" in line for line in model.unmapped), model.unmapped

@@ -19,7 +19,7 @@ from rich.console import Console
 from rich.table import Table
 
 from . import __version__
-from .errors import OutputError, SceneTooLarge, ShellsimError, Terminated
+from .errors import DeckError, OutputError, SceneTooLarge, ShellsimError, Terminated
 from .output.folder import output_folder
 from .printable import shown
 from .signals import handling
@@ -212,27 +212,35 @@ def import_model(
         "--user-material", help="The law of the file's user materials, each with its own constants: 'MODEL: KEY = "
                                 "$n | number, ...' ($n: the n-th constant), e.g. 'lee_sacks: c0 = $1, c1 = $2, "
                                 "c2 = $3, c3 = 0, delta = 1'.")] = None,
+    units: Annotated[str | None, typer.Option(
+        "--units", help="The file's unit system (SI, mm-t-s, mm-kg-ms, in-lbf-s) [default: recognised from its "
+                        "densities].")] = None,
 ) -> None:
     """Bring a model made with another program over as an editable deck and its mesh:
     shells as 9-node quads with their sets and material axes, and the material, section,
     supports, loads, contact, amplitudes and first step as deck tables. What has no
     counterpart is listed (and written at the top of the deck), never dropped silently."""
+    from .foreign.units import DENSITY_IN_SI
     from .foreign.user_law import UserLaw
     from .imported_deck import import_model as bring_over
 
     user_law = UserLaw.parse(user_material) if user_material is not None else None
+    if units is not None and units not in DENSITY_IN_SI:
+        raise DeckError("--units", [f"got '{units}'; expected one of {', '.join(DENSITY_IN_SI)}"])
     folder = output_folder(out_dir or Path(model.stem))
     with err.status(f"reading {model}"):
-        done = bring_over(model, folder, user_law)
+        done = bring_over(model, folder, user_law, units)
     sets = ", ".join(f"{name} ({kind})" for name, kind in sorted(done.sets.items()))
     cables = f", {done.cables} cable elements" if done.cables else ""
     out.print(f"{shown(str(model))}: {done.elements} elements{cables}; sets: {shown(sets) or 'none'}",
               highlight=False)
+    if done.units is not None:
+        out.print(f"units: {done.units} (meta.units){'' if units else ', recognised from the densities; say --units otherwise'}")
     if done.unmapped:
         err.print("[yellow]not brought over[/] (listed at the top of the deck too):")
         for line in done.unmapped:
             err.print(f"  - {shown(line)}", highlight=False)
-    _announce([done.deck, done.mesh])
+    _announce([done.deck, done.mesh, done.ids])
     if done.problems:
         err.print(f"[yellow]{done.deck} needs editing before it runs:[/]")
         for line in done.problems:

@@ -17,28 +17,34 @@ from .output.folder import output_folder, write_atomically
 from .printable import printable
 
 DECK_NAME = "deck.toml"
+#: The table of the model file's labels against shellsim's node and element indices.
+ID_MAP_NAME = "ids.csv"
 #: The deck's tables in the order a reader expects them.
 ORDER = ("meta", "geometry", "material", "section", "boundary", "load", "contact", "cable", "curves", "solver")
 
 
 @dataclass(frozen=True)
 class Imported:
-    """What ``shellsim import`` wrote: the deck, the mesh, its shell and cable element
-    counts, the sets, the lines of what was not brought over and the deck's problems
-    (empty when it runs as written)."""
+    """What ``shellsim import`` wrote: the deck, the mesh, the id map, its shell and cable
+    element counts, the sets, the lines of what was not brought over, the deck's
+    problems (empty when it runs as written) and its unit system (None: not known)."""
 
     deck: Path
     mesh: Path
+    ids: Path
     elements: int
     cables: int
     sets: dict[str, str]
     unmapped: list[str]
     problems: list[str]
+    units: str | None
 
 
-def import_model(source: Path, folder: Path, user_law=None) -> Imported:
-    """Bring the model ``source`` over into ``folder`` as DECK_NAME and ``<stem>.vtu``, its
-    user materials mapped by ``user_law`` (:class:`shellsim.foreign.user_law.UserLaw`).
+def import_model(source: Path, folder: Path, user_law=None, units: str | None = None) -> Imported:
+    """Bring the model ``source`` over into ``folder`` as DECK_NAME, ``<stem>.vtu`` and
+    ID_MAP_NAME (kind, the file's label, shellsim's 0-based index: the mesh file's point or
+    cell id), its user materials mapped by ``user_law``
+    (:class:`shellsim.foreign.user_law.UserLaw`), in ``units`` (recognised without).
 
     Refuses (OutputError) to replace a deck already in ``folder``; MeshError for a model
     that cannot be read. The deck is validated and its sets checked against the mesh; its
@@ -49,18 +55,27 @@ def import_model(source: Path, folder: Path, user_law=None) -> Imported:
     deck_path, mesh_path = folder / DECK_NAME, folder / f"{source.stem}.vtu"
     if deck_path.exists():
         raise OutputError(f"'{deck_path}' exists: import into another folder (--out) or move it away first")
-    model = read_foreign(source, user_law)
+    model = read_foreign(source, user_law, units)
     output_folder(folder)
     m = model.mesh
     thickness = m.thickness if m.thickness is not None else np.full(len(m.x), model.tables["section"]["thickness"])
     mesh = Mesh(x=m.x, conn=m.conn, director=m.director, thickness=thickness, sets=m.sets,
                 cell_vectors=m.cell_vectors, point_fields=m.point_fields, cell_fields=m.cell_fields, lines=m.lines)
     write_mesh_vtu(mesh, mesh_path, with_thickness=m.thickness is not None)
+    ids_path = folder / ID_MAP_NAME
+    write_atomically(ids_path, "kind,label,index\n" + "".join(f"{kind},{_csv(label)},{index}\n"
+                                                           for kind, label, index in model.id_map))
     tables = model.tables | {"geometry": {"builder": "file", "path": mesh_path.name}}
     text = _header(source, model.unmapped) + deck_text({key: tables[key] for key in ORDER if key in tables})
     write_atomically(deck_path, text)
     sets = {name: s.kind for name, s in m.sets.items()}
-    return Imported(deck_path, mesh_path, len(m.conn), len(m.lines), sets, model.unmapped, _problems(deck_path))
+    return Imported(deck_path, mesh_path, ids_path, len(m.conn), len(m.lines), sets, model.unmapped,
+                    _problems(deck_path), model.tables["meta"].get("units"))
+
+
+def _csv(text: str) -> str:
+    """``text`` as a CSV field: quoted where it holds a comma or a quote."""
+    return '"' + text.replace('"', '""') + '"' if any(c in text for c in ',"\n') else text
 
 
 def deck_text(tables: dict) -> str:

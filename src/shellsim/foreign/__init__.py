@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import MeshError
 from ..mesh import ImportedMesh
+from .units import with_units
 
 
 @dataclass(frozen=True)
@@ -25,12 +26,15 @@ class ForeignModel:
         the keyword and where it was written and what the deck says instead.
     unused_elements : the lines of those that concern the mesh (elements left out), so that
         a deck reading the file's mesh directly can refuse it rather than lose them.
+    id_map : (kind, the file's label, shellsim's index) of each node, element and cable
+        element (:meth:`.shell_mesh.ShellMesh.id_map`).
     """
 
     mesh: ImportedMesh
     tables: dict
     unmapped: list[str]
     unused_elements: list[str]
+    id_map: list[tuple[str, str, int]]
 
 
 def meta_table(path: Path, title: str) -> dict:
@@ -38,9 +42,10 @@ def meta_table(path: Path, title: str) -> dict:
     return {"title": title, "description": f"Brought over from {path.name}", "source": path.name}
 
 
-def read_foreign(path: Path, user_law=None) -> ForeignModel:
+def read_foreign(path: Path, user_law=None, units: str | None = None) -> ForeignModel:
     """The model in ``path``, read by the reader of its suffix; MeshError for another file.
-    ``user_law`` (:class:`.user_law.UserLaw`) maps its user materials onto a law."""
+    ``user_law`` (:class:`.user_law.UserLaw`) maps its user materials onto a law; ``units``
+    names the file's unit system (recognised from its densities without)."""
     reader = READERS.get(Path(path).suffix.lower())
     if reader is None:
         raise MeshError(f"'{path}' is not a model file shellsim reads (suffixes: {', '.join(sorted(READERS))})")
@@ -54,7 +59,9 @@ def read_foreign(path: Path, user_law=None) -> ForeignModel:
         raise MeshError(f"model file '{path}' ({Path(path).stat().st_size / 1e6:,.0f} MB) does not fit in the memory "
                         "this process may use to read it; read it on a machine with more memory, or split its "
                         "mesh out") from None
-    return replace(model, unmapped=grouped(model.unmapped))
+    notes = list(model.unmapped)
+    tables = with_units(model.tables, units, notes)
+    return replace(model, tables=tables, unmapped=grouped(notes))
 
 
 #: A note's place in the file: '(name.inp:123)' after the keyword it is about.

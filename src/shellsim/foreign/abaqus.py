@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..deck.material import MATERIALS
 from ..errors import MeshError
 from ..loads.cable_laws import OGDEN_TERMS
 from . import ForeignModel, meta_table
@@ -58,8 +59,10 @@ def read_abaqus(path: Path, user_law: UserLaw | None = None) -> ForeignModel:
     builder.supports_and_loads()
     builder.contact()
     builder.solver()
+    builder.mass_scaling()
     tables = {"meta": meta_table(path, model.heading or path.stem)} | builder.tables
-    return ForeignModel(builder.shells.imported(), tables, model.unmapped, builder.unused_elements)
+    return ForeignModel(builder.shells.imported(), tables, model.unmapped, builder.unused_elements,
+                        builder.shells.id_map())
 
 
 class _Builder:
@@ -334,10 +337,32 @@ class _Builder:
             m.unmapped.append(f"{option.label()}: *{option.name.upper()} of material '{name}' is not read")
         if table is None:
             return None
+        table = self._with_axes(table, section, prefix)
         if self.density is None:
             m.unmapped.append(f"{k.label()}: material '{name}' has no *DENSITY; the deck's density 1.0 is a "
                               "placeholder (only an explicit run uses it)")
         return table | {"density": self.density if self.density is not None else 1.0}
+
+    def _with_axes(self, table: dict, section: Keyword, prefix: str) -> dict:
+        """``table`` with the section's orientation as its ``axes`` where its law takes axes
+        and has none yet (Abaqus' default, x projected on the shell, where the section names
+        none); a law without axes leaves an orientation out, listed. An axis of no length
+        is listed and left out."""
+        orientation = section.param("orientation")
+        if "axes" in table:
+            return table
+        if "axes" not in MATERIALS[table["model"]].model_fields:
+            if orientation is not None:
+                self.model.unmapped.append(f"{section.label()}: ORIENTATION={orientation} is not carried: the "
+                                           f"{table['model']} law has no material axes")
+            return table
+        axes, _ = self._axes(section, prefix)
+        if axes["kind"] == "fixed" and not np.linalg.norm(axes["direction"]) > 0.0:
+            self.model.unmapped.append(f"{section.label()}: the direction of ORIENTATION={orientation} is (0, 0, 0), "
+                                       f"which points nowhere; the {table['model']} law's axes are left to its "
+                                       "default (cylindrical): give material.axes")
+            return table
+        return table | {"axes": axes}
 
     def _hyperelastic(self, k: Keyword) -> dict | None:
         forms = [f for f in ("neo hooke", "mooney-rivlin", "polynomial", "reduced polynomial", "ogden", "yeoh",
@@ -487,7 +512,7 @@ class _Builder:
                 loads += self._cload(k)
             elif k.name in ("dload", "dsload"):
                 loads += self._distributed(k)
-        for k, tokens, dofs in held.values():
+        for k, tokens, dofs in _one_per_kind(held):
             entry = self._support(k, tokens, dofs)
             if entry is not None:
                 boundary.append(entry)
@@ -545,7 +570,8 @@ class _Builder:
                     entry["values"][label] = value
 
     def _support(self, k: Keyword, tokens: list[str], dofs: set[int]) -> dict | None:
-        name = self.node_set_for(k, tokens, f"support_{tokens[0]}")
+        wanted = f"support_{tokens[0]}" if len(tokens) == 1 else "held_" + "".join(map(str, sorted(dofs)))
+        name = self.node_set_for(k, tokens, wanted)
         entry, problem = support_table(name, {d for d in dofs if d <= 3}, {d for d in dofs if d > 3})
         if problem:
             self.model.unmapped.append(f"{k.label()}: {problem}")
@@ -718,7 +744,7 @@ class _Builder:
         step, items = m.steps[0]
         procedures = [k for k in items if k.name in ("static", "dynamic")]
         known = {"static", "dynamic", "boundary", "cload", "dload", "dsload", "contact pair", "contact",
-                 "contact inclusions", "contact property assignment"}
+                 "contact inclusions", "contact property assignment", *MASS_SCALING}
         for k in items:
             if k.name not in known and k.name not in OUTPUT_REQUESTS:
                 m.unmapped.append(f"{k.label()}: not read by shellsim")
@@ -739,6 +765,57 @@ class _Builder:
                 m.unmapped.append(f"{k.label()}: implicit dynamics: shellsim integrates the step explicitly")
             solver = {"method": "explicit", "end_time": row[1] or 1.0}
         self.tables["solver"] = solver
+
+    def mass_scaling(self) -> None:
+        """``*VARIABLE`` or ``*FIXED MASS SCALING`` of the first step to a time step DT: on a
+        set of line elements, its cables' ``min_step`` (each element made heavier until its
+        own step is DT, as TYPE=BELOW MIN does); on shells or the whole model, the explicit
+        solve's uniform ``[solver.mass_scaling]`` (listed: every mass scaled by one factor,
+        not each element's by its own)."""
+        m = self.model
+        for k in (k for k in (m.steps[0][1] if m.steps else []) if k.name in MASS_SCALING):
+            step, elset, kind = k.param("dt"), k.param("elset"), (k.param("type") or "uniform").lower()
+            if step is None or not _is_number(step) or kind not in ("below min", "uniform", "set equal dt"):
+                m.unmapped.append(f"{k.label()}: only mass scaling to a time step (DT=, TYPE=BELOW MIN, UNIFORM or "
+                                  "SET EQUAL DT) is read; a FACTOR= or target steps are not")
+                continue
+            lines = self.shells.set_of.get(("lines", m.key_of(m.elsets, elset, "", k, "element set"))) if elset else None
+            inside = set(self.shells.sets[lines].elements) if lines else set()
+            cables = [c for c in self.tables.get("cable", []) if set(self.shells.sets[c["set"]].elements) <= inside]
+            if cables:
+                for cable in cables:
+                    cable["min_step"] = float(step)
+                if kind == "set equal dt":
+                    m.unmapped.append(f"{k.label()}: TYPE=SET EQUAL DT also makes the stiffer elements lighter; the "
+                                      f"cables of '{lines}' are only made heavier (cable.min_step)")
+                continue
+            if self.tables["solver"].get("method") != "explicit":
+                m.unmapped.append(f"{k.label()}: mass scaling is for an explicit solve; not read")
+                continue
+            self.tables["solver"]["mass_scaling"] = {"step": float(step)}
+            m.unmapped.append(f"{k.label()}: {'ELSET=' + elset if elset else 'the whole model'}, TYPE="
+                              f"{kind.upper()}: brought over as [solver.mass_scaling] step = {float(step):g}, which "
+                              "scales every mass by one factor when the stable step is shorter")
+
+
+#: Keywords that scale masses for a longer explicit step.
+MASS_SCALING = ("variable mass scaling", "fixed mass scaling")
+
+
+def _one_per_kind(held: dict[str, tuple[Keyword, list[str], set[int]]]) -> list[tuple[Keyword, list[str], set[int]]]:
+    """The supports of ``held`` (token -> first keyword, tokens, dofs) with the nodes named
+    one by one that hold the same dofs made one support: 32 papillary tips, each held by
+    its own line, are one set and one [[boundary]] table; named sets stay their own."""
+    supports, by_dofs = [], {}
+    for token, (k, tokens, dofs) in held.items():
+        if not token.startswith("node "):
+            supports.append((k, tokens, dofs))
+        elif frozenset(dofs) in by_dofs:
+            by_dofs[frozenset(dofs)][1].extend(tokens)
+        else:
+            by_dofs[frozenset(dofs)] = (k, list(tokens), dofs)
+            supports.append(by_dofs[frozenset(dofs)])
+    return supports
 
 
 def _is_number(text: str) -> bool:

@@ -42,7 +42,8 @@ def read_febio(path: Path) -> ForeignModel:
         raise MeshError(f"'{path}' is not a FEBio model of format 3.0 or 4.0 (root <{root.tag}> version "
                         f"'{version}'); FEBio Studio saves one with File > Save As")
     reader = _Reader(path, root)
-    return ForeignModel(reader.shells.imported(), reader.tables, reader.unmapped, reader.unused_elements)
+    return ForeignModel(reader.shells.imported(), reader.tables, reader.unmapped, reader.unused_elements,
+                        reader.shells.id_map())
 
 
 def _parse(path: Path) -> ET.Element:

@@ -165,8 +165,32 @@ class ShellMesh:
         return self.conn[e, [position - 4, (position - 3) % 4]]
 
     def imported(self) -> ImportedMesh:
+        """The mesh, with the file's node and element numbers as the fields SOURCE_NODE and
+        SOURCE_ELEMENT (:meth:`id_map`)."""
+        node_ids, element_ids = np.zeros(len(self.x)), np.asarray([number(self.labels[p]) for p in self.parent],
+                                                                   dtype=float)
+        for label, i in self.index_of_label.items():
+            node_ids[i] = number(label)
         return ImportedMesh(self.x, self.conn, self.sets, self.director, self.thickness, self.cell_vectors,
-                            self.point_fields, {}, self.lines)
+                            self.point_fields | {SOURCE_NODE: node_ids}, {SOURCE_ELEMENT: element_ids}, self.lines)
+
+    def id_map(self) -> list[tuple[str, str, int]]:
+        """(kind, the file's label, shellsim's index) of every node ('node'), shell element
+        ('element'; a triangle split into quads has several) and cable element ('cable')."""
+        rows = [("node", label, i) for label, i in self.index_of_label.items()]
+        rows += [("element", self.labels[p], piece) for piece, p in enumerate(self.parent)]
+        return rows + [("cable", label, i) for label, i in self.line_of_label.items()]
+
+
+#: The mesh fields that hold the model file's number of each node (0 for a node shellsim
+#: added: a mid-edge or centre node) and of each element; a run writes them in every frame.
+SOURCE_NODE, SOURCE_ELEMENT = "source_node", "source_element"
+
+
+def number(label: str) -> int:
+    """The number a file's label ends in: 12 for 'leaflet-1.12' (an instance's labels
+    repeat another's numbers: the id map tells them apart)."""
+    return int(label.rpartition(".")[2])
 
 
 def deck_name(wanted: str, lead: str) -> str:

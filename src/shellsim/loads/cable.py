@@ -45,7 +45,10 @@ class Cable(LoadTable):
     node: hold it, or move it on a curve, with a ``[[boundary]]``; free, it moves with the
     chords' masses). Its strain energy counts as work of external forces. A static solve
     (or preload) takes one segment per chord, and a free tip needs holding across the
-    chords (a string at rest has no lateral stiffness)."""
+    chords (a string at rest has no lateral stiffness). ``min_step`` [time]: each element
+    whose own critical step at rest is shorter is made heavier until it is this (Abaqus'
+    ``*VARIABLE MASS SCALING, TYPE=BELOW MIN`` on the set, done once at the start): a
+    chord's short stiff segments then no longer set an explicit run's step."""
 
     type: Literal["cable"] = "cable"
     name: Name
@@ -57,6 +60,7 @@ class Cable(LoadTable):
     law: CableLaw
     rest_length: Positive = 1.0
     gravity: Vec3 = (0.0, 0.0, 0.0)
+    min_step: Positive | None = None
     DECK_KEY: ClassVar[str] = "cable"
     SET_KINDS: ClassVar[tuple[str, ...]] = ("point", "edge", "surface", "line")
     FEATURES: ClassVar[tuple[str, ...]] = ("cables",)
@@ -71,11 +75,12 @@ class Cable(LoadTable):
     @property
     def summary(self) -> str:
         """One line for ``shellsim check``."""
-        law = ", ".join(f"{k}={v:g}" for k, v in self.law.model_dump().items() if k != "model")
+        law = ", ".join(f"{k}={_numbers(v)}" for k, v in self.law.model_dump().items() if k != "model")
         slack = f", rest length x {self.rest_length:g}" if self.rest_length != 1.0 else ""
         chords = (f"the line elements of '{self.set}'" if self.tip is None else
                   f"a chord from each node of '{self.set}' to {list(self.tip)} in {self.segments} segment(s)")
-        return f"'{self.name}': {chords}, area {self.area:g}, {self.law.model} ({law}){slack}"
+        heavier = f", elements of a step below {self.min_step:g} made heavier to it" if self.min_step else ""
+        return f"'{self.name}': {chords}, area {self.area:g}, {self.law.model} ({law}){slack}{heavier}"
 
     @property
     def declared_sets(self) -> dict[str, str]:
@@ -86,6 +91,11 @@ class Cable(LoadTable):
     def elements(self) -> str:
         """The line set that holds the table's elements."""
         return self.set if self.tip is None else self.name
+
+
+def _numbers(value: float | list[float]) -> str:
+    """A law's parameter for a line: 2.5, or [1, 2.5] for one of several terms."""
+    return f"[{', '.join(f'{v:g}' for v in value)}]" if isinstance(value, list) else f"{value:g}"
 
 
 TABLES = (Cable,)
@@ -176,8 +186,12 @@ def build(table: Cable, scene) -> Bundle:
     nodes = mesh.lines[mesh.sets[table.elements].elements]
     count = len(nodes)
     code, params = code_and_parameters(table.law)
-    return Bundle(nodes=nodes, rest=table.rest_length * np.linalg.norm(mesh.x[nodes[:, 1]] - mesh.x[nodes[:, 0]], axis=1),
-                  area=np.full(count, table.area), density=np.full(count, table.density),
+    rest = table.rest_length * np.linalg.norm(mesh.x[nodes[:, 1]] - mesh.x[nodes[:, 0]], axis=1)
+    density = np.full(count, table.density)
+    if table.min_step is not None:  # sqrt(rho A L / (A P'(1) / L)) = L sqrt(rho / P'(1)) made min_step
+        own_step = rest * np.sqrt(table.density / nominal_stress(code, params, 1.0)[1])
+        density *= np.maximum(1.0, (table.min_step / own_step) ** 2)
+    return Bundle(nodes=nodes, rest=rest, area=np.full(count, table.area), density=density,
                   law=np.full(count, code, dtype=np.int64), params=np.tile(params, (count, 1)),
                   gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
 

@@ -16,7 +16,7 @@ from ..errors import OutputError
 from ..memory import size_text
 from ..solver.run import Listener, Run
 from .encoding import Encoding
-from .fields import cable_fields, cable_mesh, frame_fields, output_mesh
+from .fields import cable_fields, cable_mesh, frame_fields, output_mesh, source_ids
 from .mirror import mirror_planes, mirrored_mesh, mirrored_values, mirrors
 from .vtu import VtuSeries, pvd_entries
 from .xdmf import XdmfSeries
@@ -40,6 +40,7 @@ class FrameWriter(Listener):
         self.folder = folder
         self.fields, self.vessel_axes, self.faces = list(output.fields), output.vessel_axes, tuple(output.faces)
         self.part = output_mesh(run.model, output.solid)
+        self.ids = source_ids(run.mesh, run.model, self.part)  # the same in every frame
         self.copies = mirrors(mirror_planes(run.deck, run.mesh))
         self.mesh = mirrored_mesh(self.part, self.copies)
         self.run = run
@@ -59,6 +60,7 @@ class FrameWriter(Listener):
     def _fields(self, run: Run) -> tuple[dict, dict]:
         """(point_data, cell_data) of the current state on the written (mirrored) mesh."""
         point_data, cell_data = frame_fields(run.sim, self.part, self.fields, self.vessel_axes, self.faces)
+        point_data, cell_data = point_data | self.ids[0], cell_data | self.ids[1]
         if self.copies.count == 1:
             return point_data, cell_data
         return ({name: mirrored_values(v, self.copies) for name, v in point_data.items()},

@@ -117,6 +117,8 @@ def test_missing_deck_file_is_a_deck_error(tmp_path):
         ("linear", [-1.0, 0.0, 0.5, 1.0, 1.5, 2.0, 3.0], [0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0]),
         ("step", [0.0, 0.5, 1.0, 1.5, 2.0], [0.0, 0.0, 2.0, 2.0, 2.0]),
         ("smooth", [0.0, 0.25, 0.5, 1.0], [0.0, 2.0 * (3 * 0.25**2 - 2 * 0.25**3), 1.0, 2.0]),
+        # Abaqus' SMOOTH STEP (Analysis User's Guide, 'Amplitude curves'): A0 + (A1 - A0) xi^3 (10 - 15 xi + 6 xi^2)
+        ("smooth_step", [0.0, 0.25, 0.5, 1.0], [0.0, 2.0 * 0.25**3 * (10 - 15 * 0.25 + 6 * 0.25**2), 1.0, 2.0]),
     ],
 )
 def test_curves_interpolate_as_documented(interpolate, times, expected):

@@ -81,7 +81,7 @@ def test_every_chord_comes_over_with_its_group_s_law_and_mass_scaling(imported):
 
 def test_supports_motion_pressure_contact_and_units_come_over(imported):
     """The papillary tips held node by node are one set and one table; the annulus moves
-    node by node as the file says; 23 mmHg on the leaflets on the smooth curve; one
+    node by node as the file says; 23 mmHg on the leaflets on the smooth step; one
     self-contact with the file's friction, the overclosure stiffness listed with its
     value; units mm-t-s."""
     deck = load_deck(imported.deck)
@@ -97,6 +97,7 @@ def test_supports_motion_pressure_contact_and_units_come_over(imported):
             assert mesh.point_fields[b.field][node] == pytest.approx(u[axis], abs=1e-12)
     pressure, = deck.load
     assert pressure.curve == "Closing" and pressure.value == pytest.approx(-23 * 133.322387415e-6, rel=1e-12)
+    assert deck.curves["Closing"].interpolate == "smooth_step"
     contact, = deck.contact
     assert contact.set == "all" and contact.against is None and contact.friction == FRICTION
     assert any(f"PRESSURE-OVERCLOSURE=LINEAR ({OVERCLOSURE_STIFFNESS})" in line for line in imported.unmapped)

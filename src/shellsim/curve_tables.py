@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit
 
 #: Codes of a table's interpolation and extrapolation.
-INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2}
+INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2, "smooth_step": 3}
 EXTRAPOLATION = {"constant": 0, "linear": 1}
 
 
@@ -29,6 +29,8 @@ def curve_value(t: np.ndarray, v: np.ndarray, interpolate: int, extrapolate: int
         return v[i]
     if interpolate == 2:
         u = u * u * (3.0 - 2.0 * u)
+    elif interpolate == 3:
+        u = u * u * u * (10.0 - 15.0 * u + 6.0 * u * u)
     return v[i] + u * (v[i + 1] - v[i])
 
 

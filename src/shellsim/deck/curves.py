@@ -18,8 +18,9 @@ class Curve(Section):
     """A tabulated factor of time: ``t`` and ``value``, or ``file``.
 
     ``interpolate``: ``linear`` between points, ``step`` (holds the value of the last point
-    passed) or ``smooth`` (cubic with zero slope at every point, so a ramp starts and ends
-    without a jolt). ``extrapolate``: beyond the table, ``constant`` holds the end values,
+    passed), ``smooth`` (cubic with zero slope at every point, so a ramp starts and ends
+    without a jolt) or ``smooth_step`` (Abaqus' SMOOTH STEP: the quintic u^3 (10 - 15 u +
+    6 u^2) between points, zero slope and curvature at each). ``extrapolate``: beyond the table, ``constant`` holds the end values,
     ``linear`` continues the end segments.
 
     ``file``: a CSV file of (time, value) rows (a path relative to the deck; header lines
@@ -37,7 +38,7 @@ class Curve(Section):
     file: str | None = None
     time_scale: Positive = 1.0
     value_scale: Real = 1.0
-    interpolate: Literal["linear", "step", "smooth"] = "linear"
+    interpolate: Literal["linear", "step", "smooth", "smooth_step"] = "linear"
     extrapolate: Literal["constant", "linear"] = "constant"
     repeat: Count = 1
     period: Positive | None = None

@@ -479,10 +479,7 @@ class _Builder:
             name = deck_name(k.param("name") or "amplitude", "curve")
             curve = {"t": t, "value": a}
             if definition == "smooth step":
-                curve["interpolate"] = "smooth"
-                self.model.unmapped.append(f"{k.label()}: SMOOTH STEP is brought over as shellsim's smooth curve "
-                                           "(a cubic with zero slope at every point; Abaqus' is a quintic: the same at "
-                                           "the points, close between)")
+                curve["interpolate"] = "smooth_step"
             curves[name] = curve
             self.curve_of[key] = name
         self.used_curves: set[str] = set()

@@ -362,12 +362,15 @@ def test_a_preload_hands_its_equilibrium_to_the_explicit_run_without_a_jump(tmp_
 
 
 def test_preload_and_arc_length_settings_that_cannot_work_are_refused(tmp_path):
-    """A preload at or past the end, a preload on a static run, and arc-length control
-    with a prescribed motion are deck errors naming the key."""
+    """A preload at or past the end, a preload on a static or implicit run, and arc-length
+    control with a prescribed motion are deck errors naming the key."""
     aorta = _preloaded_aorta(tmp_path, 0.16)
     cases = {
         "late": (aorta.replace("preload = 0.14", "preload = 0.2"), "must come before end_time"),
-        "static": (aorta.replace("preload = 0.14", 'preload = 0.14\nmethod = "static"'), "static throughout"),
+        "static": (aorta.replace("preload = 0.14", 'preload = 0.14\nmethod = "static"'),
+                   "'preload' is for explicit runs"),
+        "implicit": (aorta.replace("preload = 0.14", 'preload = 0.14\nmethod = "implicit"'),
+                     "'preload' is for explicit runs"),
         "prescribed": ((ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3_static.toml").read_text()
                        .replace("static = { increments = 4 }", 'static = { control = "arc_length" }')
                        .replace("[[load]]", '[[boundary]]\ntype = "prescribed"\nset = "tip"\ntranslation = "z"\n'

@@ -104,17 +104,17 @@ def check(deck: DeckPath) -> None:
 
     scene = load_deck(deck)
     mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{shown(text)}[/]", highlight=False))
-    static = scene.solver.method == "static"
+    newton_steps = scene.solver.method != "explicit"  # static or implicit: a tangent's cost
     with err.status("building the model") as status, _compiles_shown(status):
         model = build_model(scene, mesh)
-        if static:
+        if newton_steps:
             outlook = static_outlook(model)
         else:
             status.update("estimating the critical time step")
             outlook = step_outlook(scene, model, lambda count: status.update(
                 f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
-    if not static:
+    if not newton_steps:
         refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
     if scene.solver.ramp_end is not None:  # a static solve, or a static preload
         _warn_of_hanging_nodes(scene, mesh, model)
@@ -122,13 +122,13 @@ def check(deck: DeckPath) -> None:
         crossing = crossing_problem(mesh.x, mesh.conn)
     if crossing:
         err.print(f"[yellow]warning:[/] {shown(crossing)}", highlight=False)
-    if not static and scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
+    if not newton_steps and scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(
             f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "
             "step: with M2 the rotary inertia of this thin shell sets the critical step (M1 floors it, "
             "thesis 3.14.1; on coarse meshes that slows bending: Test 1 on 2x2 peaks 7% late, docs/verification.md)"
         )
-    if not static and scene.solver.dt_safety_factor < 1.0:
+    if not newton_steps and scene.solver.dt_safety_factor < 1.0:
         err.print(
             f"[yellow]warning:[/] solver.dt_safety_factor = {scene.solver.dt_safety_factor} < 1 "
             "puts the time step above the critical step: the run will be unstable"
@@ -270,7 +270,8 @@ def run(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
     """Run a scene: in time by explicit central differences, or as equilibria by Newton
-    load steps (solver.method = "static"). Writes OUT/summary.json,
+    load steps (solver.method = "static"), or in time by implicit Newton steps (solver.method =
+    "implicit"). Writes OUT/summary.json,
     OUT/history.csv, OUT/deck.toml (the resolved deck), the frames (OUT/results.xdmf + .h5,
     and OUT/results.pvd + OUT/frames/ when asked) and the deck's renders. With --resume
     FOLDER, a run that stopped goes on from its last checkpoint there, with the deck it was
@@ -606,6 +607,13 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                 f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")
         row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
                               f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
+    elif sv.method == "implicit":
+        im = sv.implicit
+        row("solver", f"implicit dynamics (HHT, alpha {im.alpha:g}) to t = {sv.end_time} in {im.increments} time "
+                      f"steps first ({im.newton} Newton, at most {im.max_iterations} iterations each), mass {sv.mass}"
+                      + (f", damping {sv.damping}/s" if sv.damping else ""))
+        row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
+                    f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
     else:
         if sv.preload is not None:
             row("preload", f"static load steps to t = {sv.preload} ({sv.static.increments} first), "

@@ -60,14 +60,15 @@ def built_run(scene: Deck, deck_folder: Path, announce: Callable[[str], None] = 
 
 
 def solve(run: Run, listener: Listener | None = None) -> Run:
-    """Solve ``run`` by its deck's method: statically, explicitly, or explicitly after a
-    static preload; a run restored from a checkpoint goes on in time."""
+    """Solve ``run`` by its deck's method: statically, implicitly, explicitly, or
+    explicitly after a static preload; a run restored from a checkpoint goes on in time."""
+    from .solver.implicit import solve_implicit
     from .solver.preload import preload_then_integrate
     from .solver.run import integrate
     from .solver.static_solve import solve_static
 
     solver = run.deck.solver
-    method = (solve_static if solver.method == "static" else
+    method = (solve_static if solver.method == "static" else solve_implicit if solver.method == "implicit" else
               integrate if solver.preload is None or run.stepping is not None else preload_then_integrate)
     return method(run, listener)
 

@@ -91,6 +91,7 @@ def deck_reference() -> str:
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")
     lines += _table(schema.Static, "### [solver.static]")
+    lines += _table(schema.Implicit, "### [solver.implicit]")
     lines += _table(schema.Output, "## [output]")
     lines += _table(schema.Render, "## [[output.render]]")
     for family in FAMILIES:

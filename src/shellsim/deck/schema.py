@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import json
 from itertools import combinations
-from typing import Annotated, Literal, Union, get_args
+from typing import Annotated, ClassVar, Literal, Union, get_args
 
 import numpy as np
 from pydantic import BeforeValidator, Field, create_model, field_serializer, field_validator, model_validator
@@ -171,7 +171,19 @@ Contact = _chosen_by_type(CONTACT_TABLES)
 Cable = _chosen_by_type(CABLE_TABLES)
 
 
-class Static(Section):
+class NewtonSteps(Section):
+    """The Newton-Raphson steps a static or implicit solve takes (the keys
+    ``[solver.static]`` and ``[solver.implicit]`` share; see :class:`Static`)."""
+
+    newton: Literal["modified", "full"] = "modified"
+    increments: Count = 1
+    max_iterations: Count = 25
+    force_tolerance: Positive = 1e-6
+    energy_tolerance: Positive = 1e-12
+    min_increment: Positive = 1e-6
+
+
+class Static(NewtonSteps):
     """``[solver.static]``: the Newton-Raphson load steps of ``method = "static"``.
 
     The pseudo-time runs from 0 to ``solver.end_time``; the loads follow their curves in it,
@@ -214,13 +226,32 @@ class Static(Section):
     ``static.stability``), and history.csv's load factors tell the load reached."""
 
     control: Literal["load", "arc_length"] = "load"
-    newton: Literal["modified", "full"] = "modified"
-    increments: Count = 1
-    max_iterations: Count = 25
-    force_tolerance: Positive = 1e-6
-    energy_tolerance: Positive = 1e-12
-    min_increment: Positive = 1e-6
     check_stability: bool = True
+
+
+class Implicit(NewtonSteps):
+    """``[solver.implicit]``: implicit dynamics (``method = "implicit"``), the HHT-alpha
+    method (Hilber, Hughes and Taylor 1977) on the static solve's Newton steps: each time
+    step solves M a + (1 + alpha) f_int(u) - alpha f_int(u_n) = (1 + alpha) f_ext(t) -
+    alpha f_ext(t_n) with Newmark's beta = (1 - alpha)^2 / 4, gamma = 1/2 - alpha, the
+    lumped masses of the explicit run (``solver.mass``) giving the tangent its
+    M / (beta dt^2). ``alpha`` = 0 is the trapezoidal rule (energy kept exactly in a
+    linear system, no numerical damping); down to -1/3 it damps the highest frequencies
+    (the step's) ever more while keeping the low ones, as Abaqus/Standard's dynamics
+    (-0.05 by default, as there) and a quasi-static closing (-1/3, with long steps) use.
+    The masses keep a node with no stiffness (a slack chord's) well posed, where a static
+    solve finds its tangent singular. Time is real time: loads act as their curves say
+    (in full from the start without one), and the steps (``increments`` over
+    ``solver.end_time`` first) grow by half after easy steps and are cut to a quarter
+    where Newton fails, down to ``min_increment`` of the end time, as static load steps
+    are; each lands on the output times. Kinetic energy joins the energies; what HHT damps
+    shows as the balance error."""
+
+    increments: Count = 100
+    alpha: Real = Field(default=-0.05, ge=-1.0 / 3.0, le=0.0)
+    #: The static path's check of the converged states' stability has no meaning here:
+    #: the mass term makes every tangent positive definite.
+    check_stability: ClassVar[bool] = False
 
 
 class MassScaling(Section):
@@ -268,9 +299,10 @@ class Imaged(Section):
 
 class Solver(Section):
     """``[solver]``: central differences from t = 0 to ``end_time`` (``method =
-    "explicit"``, the default), or static equilibrium by Newton-Raphson load steps over
+    "explicit"``, the default), static equilibrium by Newton-Raphson load steps over
     the pseudo-time 0 to ``end_time`` (``method = "static"``, settings in
-    ``[solver.static]``).
+    ``[solver.static]``), or implicit dynamics by Newton-Raphson time steps (``method =
+    "implicit"``, settings in ``[solver.implicit]``).
 
     Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
     inverse), Δt_critical re-estimated at least every ``dt_update_every`` steps, and more
@@ -290,8 +322,9 @@ class Solver(Section):
 
     ``imaged``: the mesh is the shape at a load, the scene starts unloaded (``[solver.imaged]``)."""
 
-    method: Literal["explicit", "static"] = "explicit"
+    method: Literal["explicit", "static", "implicit"] = "explicit"
     static: Static = Static()
+    implicit: Implicit = Implicit()
     end_time: Positive
     preload: Positive | None = None
     dt_safety_factor: Positive = 1.25
@@ -305,20 +338,18 @@ class Solver(Section):
 
     @model_validator(mode="after")
     def _explicit_only(self) -> "Solver":
-        if self.method == "static":
-            for key in ("mass_scaling", "relaxation"):
+        if self.method != "explicit":
+            for key in ("mass_scaling", "relaxation", "preload"):
                 if getattr(self, key) is not None:
-                    raise ValueError(f"'{key}' is for explicit runs; a static run has no masses or time steps "
-                                     "to scale or relax, so drop it or set method = 'explicit'")
+                    raise ValueError(f"'{key}' is for explicit runs (it scales, relaxes or prestresses the central "
+                                     f"differences' time loop), and method = '{self.method}'; drop it or set "
+                                     "method = 'explicit'")
         return self
 
     @model_validator(mode="after")
     def _preload_fits(self) -> "Solver":
         if self.preload is None:
             return self
-        if self.method == "static":
-            raise ValueError("'preload' solves the start of an explicit run statically; a static run is static "
-                             "throughout, so drop it or set method = 'explicit'")
         if self.preload >= self.end_time:
             raise ValueError(f"preload = {self.preload} must come before end_time = {self.end_time}")
         if self.static.control != "load":
@@ -607,9 +638,10 @@ class Deck(Section):
             problems += _constitutive_path_problems(material, self.section)
         problems += _mirror_problems(self.output.mirror, self.boundary)
         problems += field_problems(self)
-        if self.output.checkpoint_interval is not None and self.solver.method == "static":
+        if self.output.checkpoint_interval is not None and self.solver.method != "explicit":
             problems.append(f"output.checkpoint_interval = {self.output.checkpoint_interval:g}: checkpoints are of "
-                            "the explicit time loop, and solver.method = 'static' solves in load steps; drop it")
+                            f"the explicit time loop, and solver.method = '{self.solver.method}' solves in Newton "
+                            "steps; drop it")
         if self.output.display_units and self.meta.units == "consistent":
             problems.append("output.display_units: meta.units = 'consistent' names no units to convert from; give "
                             f"meta.units (one of {', '.join(u for u in SYSTEMS if u != 'consistent')})")
@@ -618,6 +650,10 @@ class Deck(Section):
             problems += [f"contact[{i}].friction = {c.friction:g}: friction opposes sliding velocities, and a static "
                          "solve has none (it is frictionless); give friction = 0, or solver.method = 'explicit'"
                          for i, c in enumerate(self.contact) if c.friction]
+        if self.solver.method == "implicit":
+            problems += [f"contact[{i}].friction = {c.friction:g}: the implicit solve takes contact without "
+                         "friction (its sliding impulses are the explicit loop's); give friction = 0, or "
+                         "solver.method = 'explicit'" for i, c in enumerate(self.contact) if c.friction]
         if self.solver.ramp_end is not None:  # a static solve, or a static preload
             problems += [f"cable[{i}].segments = {c.segments}: a chord's interior nodes have no stiffness while it "
                          "is slack, so a static solve cannot find them; give segments = 1, or an explicit run "

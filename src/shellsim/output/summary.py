@@ -79,6 +79,7 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         "features": {"used": plan.used(), "left_out": plan.left_out()},
         **large_strain,
         **({"static": static_record(run)} if run.deck.solver.ramp_end is not None else {}),
+        **({"implicit": static_record(run)} if run.deck.solver.method == "implicit" else {}),
         **{measure.NAME: entry for measure in run.measures
            if (entry := measure.record(run, output_seconds)) is not None},
         **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0)}}
@@ -98,7 +99,7 @@ def unstarted(scene, deck_path: Path, message: str, status: str = "not converged
 
 
 def static_record(run: Run) -> dict:
-    """A static solve's load steps: how many, the Newton iterations, tangents formed and
+    """A static solve's load steps (an implicit one's time steps): how many, the Newton iterations, tangents formed and
     cut-backs over them, the largest relative residual a step ended with, the load time
     reached at the end and the largest on the way (an arc-length path's clock can end
     short of its load) with each curve's largest load factor, each step, and where the

@@ -1,5 +1,6 @@
 """Static equilibrium of a simulation's state: the residual force over the unknowns, the
-tangent stiffness assembled sparse, and the state moved by a correction.
+tangent stiffness assembled sparse, and the state moved by a correction; in an implicit
+time step, with the inertia's share of both (:mod:`.implicit`).
 
 The residual is what the time loop computes, f_ext(t) - f_int, for every formulation,
 material and load (fibre-length update included), taken over the unknowns of
@@ -66,6 +67,8 @@ class Equilibrium:
         #: where the element blocks go in the tangent
         self.pattern = tangent_pattern(model.conn, self.unknowns)
         self._frames()
+        #: the inertia of an implicit time step (:class:`shellsim.solver.implicit.HHT`); None: static
+        self.inertia = None
 
     def _frames(self) -> None:
         """Each element's node frames, to turn its block into the unknowns' directions."""
@@ -97,7 +100,10 @@ class Equilibrium:
     def residual(self) -> np.ndarray:
         """f_ext - f_int over the unknowns (size,) from the last :meth:`evaluate`."""
         s = self.sim.state
-        return self.unknowns.gather(self.unknowns.to_local(s.f_ext - s.f_int, s.fr_ext - s.fr_int))
+        f, fr = s.f_ext - s.f_int, s.fr_ext - s.fr_int
+        if self.inertia is not None:
+            f, fr = self.inertia.balanced(f, fr)
+        return self.unknowns.gather(self.unknowns.to_local(f, fr))
 
     def force_scale(self) -> float:
         """The larger of the external and internal force norms over every DOF (supports'
@@ -105,7 +111,8 @@ class Equilibrium:
         s = self.sim.state
         ext = np.sqrt(np.sum(s.f_ext**2) + np.sum(s.fr_ext**2))
         internal = np.sqrt(np.sum(s.f_int**2) + np.sum(s.fr_int**2))
-        return float(max(ext, internal))
+        inertial = self.inertia.inertial_scale() if self.inertia is not None else 0.0
+        return float(max(ext, internal, inertial))
 
     def move(self, correction: np.ndarray) -> None:
         """Add a correction (size,) of the unknowns to the state: translations along the
@@ -147,7 +154,15 @@ class Equilibrium:
                                   blocks, optimize=True).reshape(len(turned), ELEMENT_DOFS, ELEMENT_DOFS)
         tangent = self.pattern.assemble(k)
         coupled = self._coupled()
-        return tangent if coupled is None else (tangent - coupled).tocsc()
+        tangent = tangent if coupled is None else (tangent - coupled).tocsc()
+        return tangent if self.inertia is None else self.inertia.tangent(tangent, self._free_masses())
+
+    def _free_masses(self) -> np.ndarray:
+        """(n_free,) the lumped mass of each free unknown: a node's translational mass, or
+        its rotary mass for a rotation."""
+        s = self.sim.state
+        local = np.column_stack([s.mt, s.mt, s.mt, s.mr, s.mr])
+        return self.unknowns.gather(local)[:self.unknowns.n_free]
 
     def _coupled(self) -> sp.coo_matrix | None:
         """The derivative of the forces that couple nodes sharing no element (contact

@@ -190,7 +190,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
     """A run ready to start: simulation built, penalty springs set from the masses and the
     structure's critical step (:func:`shellsim.loads.calibrate`), and the measures the
     deck asks for placed on the scene (:mod:`.measures`)."""
-    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model, static=deck.solver.method == "static"),
+    run = Run(deck=deck, mesh=mesh, model=model, sim=Simulation(model, static=deck.solver.method != "explicit"),
               quality=ElementQuality(mesh))
     if needs_calibration(model):
         s = run.sim.state

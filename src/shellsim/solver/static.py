@@ -83,9 +83,10 @@ SINGULAR_ADVICE = ("A node held by nothing in some direction (a slack cable's fr
 class NewtonSolver:
     """Load steps of a run (:class:`shellsim.solver.run.Run`) to equilibrium."""
 
-    def __init__(self, run: Run):
+    def __init__(self, run: Run, settings=None):
         self.run = run
-        self.settings = run.deck.solver.static
+        #: the steps' settings: ``[solver.static]``, or ``[solver.implicit]`` for time steps
+        self.settings = settings or run.deck.solver.static
         self.eq = Equilibrium(run.sim)
         self.n_free = self.eq.unknowns.n_free
         self.last_residual = np.zeros(self.n_free)
@@ -152,7 +153,10 @@ class NewtonSolver:
     def observe(self) -> None:
         """Record the stability of the converged state: a tangent there, with its own load
         (a follower pressure's stiffness is the new load's at a step's first iterate), which
-        modified Newton goes on with."""
+        modified Newton goes on with. None in an implicit run: its tangents, with the mass
+        term, are positive definite, and the first is formed at the first iteration."""
+        if self.eq.inertia is not None:
+            return
         self.eq.evaluate(self.run.load_time)
         self.tangent = self.at_converged(f"at load time {self.run.load_time:.6g}, where the converged state's tangent "
                                          "is formed")
@@ -179,6 +183,8 @@ class NewtonSolver:
         (from earlier steps too) while each iteration leaves at most SLOW of the residual;
         when one leaves more it forms a new tangent there, or, when that iteration made the
         residual larger, goes back to the iterate before it and forms the tangent there."""
+        if self.eq.inertia is not None and self.eq.inertia.to(t):
+            self.tangent = None  # formed for another time step: its mass term is another
         # a wild iterate (an exponential law far out) has forces whose squares overflow: it is
         # no equilibrium, and is gone back from or cut back, so numpy need not warn of it
         with np.errstate(over="ignore", invalid="ignore"):
@@ -208,7 +214,7 @@ class NewtonSolver:
                 if not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
                     self.held_apart(t)
                     moved = self._moved()
-                    if moved > JUMP * predicted:
+                    if moved > JUMP * predicted and self.eq.inertia is None:
                         self.stability.jumped(self.eq.converged.t, self.run.load_time, t, moved / predicted)
                     return iteration, tangents, norm / max(scale, 1e-300)
             if iteration == settings.max_iterations:
@@ -320,6 +326,8 @@ class NewtonSolver:
     def commit(self, step: NewtonStep) -> None:
         """The state is converged at ``step``'s end: steps now start from it."""
         self.run.sim.state.steps += 1
+        if self.eq.inertia is not None:
+            self.eq.inertia.commit()
         self.eq.converged = Converged(self.run.sim)
         self.run.newton.append(step)
         self.work.add_step()

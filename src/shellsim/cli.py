@@ -100,6 +100,7 @@ def check(deck: DeckPath) -> None:
     from .geometry.crossings import crossing_problem
     from .model import build_model
     from .plan import plan
+    from .loads import overlaps_at_rest
     from .solver.outlook import refuse_if_hopeless, static_outlook, step_outlook
 
     scene = load_deck(deck)
@@ -122,6 +123,8 @@ def check(deck: DeckPath) -> None:
         crossing = crossing_problem(mesh.x, mesh.conn)
     if crossing:
         err.print(f"[yellow]warning:[/] {shown(crossing)}", highlight=False)
+    for overlap in overlaps_at_rest(model, scene.contact):
+        err.print(f"[yellow]warning:[/] {shown(overlap)}", highlight=False)
     if not newton_steps and scene.solver.mass == "M2" and outlook["M1"] > THIN_SHELL_GAIN * outlook["M2"]:
         err.print(
             f"[yellow]hint:[/] solver.mass = \"M1\" would take a {outlook['M1'] / outlook['M2']:.3g} times larger "

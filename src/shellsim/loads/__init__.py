@@ -161,6 +161,13 @@ def calibrate(model, masses: np.ndarray, rotary: np.ndarray, dt: float) -> None:
         kind.calibrate(bundle, masses, rotary, model.h0, dt)
 
 
+def overlaps_at_rest(model, contacts: list) -> list[str]:
+    """What each contact kind says of surfaces that overlap in the initial shape (one line
+    per contact table of the deck's ``contacts``)."""
+    return [line for kind, bundle in _with(model, "overlaps_at_rest")
+            for line in kind.overlaps_at_rest(bundle, contacts, model.x0)]
+
+
 def needs_calibration(model) -> bool:
     """Whether some kind of ``model`` has penalty springs for :func:`calibrate` to set."""
     return bool(_with(model, "calibrate"))

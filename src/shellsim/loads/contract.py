@@ -20,7 +20,7 @@ ROLES = {
     "load": ((), ("Bundle", "add_forces", "empty", "add_tangent", "couplings")),
     "contact": ((*CARRYING, "calibrate", "step_share", "item_forces", "item_energies", "item_gaps", "FORCE_TOTAL",
                  "SIDES"),
-                ("add_tangent", "add_friction", "deepest", "farthest_moved", "couplings", "empty")),
+                ("add_tangent", "add_friction", "deepest", "farthest_moved", "couplings", "empty", "overlaps_at_rest")),
     "cable": ((*CARRYING, "extend_mesh", "add_masses", "critical_step"), ("add_tangent", "couplings", "empty")),
 }
 #: Hooks that come together or not at all.

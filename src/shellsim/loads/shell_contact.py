@@ -103,7 +103,8 @@ class Bundle(NamedTuple):
     contacts; group (K,): the faces it is tested against (those of the same group);
     offset, penalty, friction (K,): the table's; spring (K,): s / dt_c^2 and
     inverse_mass (K,): 1/m (0 until :func:`calibrate`); ignored (K, :data:`IGNORED`): the elements whose
-    faces the node overlaps in the initial shape (-1 after the last). faces (F, 9): each
+    faces the node overlaps in the initial shape (-1 after the last), and initial_depth
+    (K,) how deep it is into the deepest of them [length] (0: none). faces (F, 9): each
     face's nodes; face_elements (F,) their elements; face_group (F,);
     face_inverse_mass (F, 9) (0 until :func:`calibrate`). Scratch: touches (K,) each
     contact node's face row (-1: none) and touch_forces (K, 10, 3) the forces on it and
@@ -119,6 +120,7 @@ class Bundle(NamedTuple):
     spring: np.ndarray
     inverse_mass: np.ndarray
     ignored: np.ndarray
+    initial_depth: np.ndarray
     faces: np.ndarray
     face_elements: np.ndarray
     face_group: np.ndarray
@@ -164,7 +166,7 @@ def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> 
         group=joined([np.full(len(n), 2 * place + i) for i, (n, _) in enumerate(passes)]),
         offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), friction=np.full(k, table.friction),
         spring=np.zeros(k),
-        inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64),
+        inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64), initial_depth=np.zeros(k),
         faces=conn[elements].astype(np.int64).reshape(-1, 9), face_elements=elements,
         face_group=joined([np.full(len(e), 2 * place + i) for i, (_, e) in enumerate(passes)]),
         face_inverse_mass=np.zeros((f, 9)), touches=np.full(k, -1, dtype=np.int64),
@@ -256,7 +258,8 @@ def _candidates(shape, loads, m, grid, work, ignoring):
     (width, origin) of :func:`_grid`. Faces that hold the node are passed over, and so
     are the node's ``ignored`` faces where ``ignoring``. With ``ignoring`` false, the
     faces it is into by more than the smoothing width are listed in loads.ignored[m]
-    instead (the initial overlaps), and -2 - count returned when more than fit."""
+    instead (the initial overlaps, the deepest's depth in loads.initial_depth[m]), and
+    -2 - count returned when more than fit."""
     width, origin = grid
     node = loads.nodes[m]
     y = shape.x[node]
@@ -276,10 +279,29 @@ def _candidates(shape, loads, m, grid, work, ignoring):
                 if listed == IGNORED:
                     return -2 - listed
                 loads.ignored[m, listed] = loads.face_elements[row]
+                loads.initial_depth[m] = max(loads.initial_depth[m], depth)
                 listed += 1
         elif depth > deepest:
             best, deepest = row, depth
     return best
+
+
+def overlaps_at_rest(loads: Bundle, tables: list, x: np.ndarray) -> list[str]:
+    """One line per contact table whose nodes overlap faces in the initial shape (x (n, 3)):
+    how many nodes, the deepest overlap and where; those faces are never pushed against."""
+    lines = []
+    for place in np.unique(loads.tool):
+        mine = (loads.tool == place) & (loads.initial_depth > 0.0)
+        if not mine.any():
+            continue
+        deepest = int(np.flatnonzero(mine)[np.argmax(loads.initial_depth[mine])])
+        node = int(loads.nodes[deepest])
+        lines.append(f"contact '{tables[place].name}': {len(np.unique(loads.nodes[mine])):,} node(s) overlap faces of "
+                     f"the other side at rest, by up to {loads.initial_depth[deepest]:.3g} (node {node + 1} at "
+                     f"{', '.join(f'{v:.4g}' for v in x[node])}): the faces a node overlaps at rest are never "
+                     "pushed against (initial penetrations ignored, as LS-DYNA's IGNORE); where the shells should "
+                     "touch there, a smaller offset or the mesh moved apart brings the contact back")
+    return lines
 
 
 @njit(cache=True, inline="always")

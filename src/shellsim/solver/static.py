@@ -153,7 +153,7 @@ class NewtonSolver:
     def observe(self) -> None:
         """Record the stability of the converged state: a tangent there, with its own load
         (a follower pressure's stiffness is the new load's at a step's first iterate), which
-        modified Newton goes on with. None in an implicit run: its tangents, with the mass
+        modified Newton goes on with. Nothing in an implicit run: its tangents, with the mass
         term, are positive definite, and the first is formed at the first iteration."""
         if self.eq.inertia is not None:
             return

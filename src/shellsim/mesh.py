@@ -72,6 +72,11 @@ class Mesh:
         return len(self.conn)
 
 
+#: The mesh fields that hold a model file's number of each node (0 for a node shellsim
+#: added: a mid-edge or centre node) and of each element; a run writes them in every frame.
+SOURCE_NODE, SOURCE_ELEMENT = "source_node", "source_element"
+
+
 @dataclass(frozen=True)
 class ImportedMesh:
     """What a file gives: x (n, 3), conn (ne, 9), sets, optional director (n, 3) and

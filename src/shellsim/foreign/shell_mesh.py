@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SHOWN_IDS, MeshError
-from ..mesh import ImportedMesh
+from ..mesh import SOURCE_ELEMENT, SOURCE_NODE, ImportedMesh
 from ..mesh import NamedSet, averaged_directors, edges_within, element_normals, orient_consistently
 from .quad_upgrade import split, upgrade
 
@@ -181,10 +181,6 @@ class ShellMesh:
         rows += [("element", self.labels[p], piece) for piece, p in enumerate(self.parent)]
         return rows + [("cable", label, i) for label, i in self.line_of_label.items()]
 
-
-#: The mesh fields that hold the model file's number of each node (0 for a node shellsim
-#: added: a mid-edge or centre node) and of each element; a run writes them in every frame.
-SOURCE_NODE, SOURCE_ELEMENT = "source_node", "source_element"
 
 
 def number(label: str) -> int:

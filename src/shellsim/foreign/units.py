@@ -30,9 +30,10 @@ def densities(tables: dict) -> list[float]:
 def with_units(tables: dict, given: str | None, notes: list[str]) -> dict:
     """``tables`` with ``meta.units``: ``given``, or recognised from the densities; left
     out, and said in ``notes``, where neither tells."""
-    units = given or recognised(densities(tables))
+    given_densities = densities(tables)
+    units = given or recognised(given_densities)
     if units is None:
-        notes.append(f"units: the densities ({', '.join(f'{rho:g}' for rho in densities(tables)) or 'none given'}) "
+        notes.append(f"units: the densities ({', '.join(f'{rho:g}' for rho in given_densities) or 'none given'}) "
                      f"name no one unit system; say which with --units ({', '.join(DENSITY_IN_SI)})")
         return tables
     return tables | {"meta": tables.get("meta", {}) | {"units": units}}

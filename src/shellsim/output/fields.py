@@ -25,7 +25,7 @@ from ..deck.output_fields import FIELD_KINDS, FIELDS, WRITTEN_AS
 from ..element.sampling import pressure_band, thickness_mean
 from ..element.shape import NODE_RS, gauss_rule, shape
 from ..materials.laws import LAWS
-from ..mesh import Mesh, node_areas
+from ..mesh import SOURCE_ELEMENT, SOURCE_NODE, Mesh, node_areas
 from ..model import Model
 from ..solver.simulation import Simulation
 from ..loads import ToolForces
@@ -131,11 +131,9 @@ CORNER_IS_NODE = np.all(np.isclose(CORNER_RS[:, None, :], NODE_RS[None], rtol=0.
 
 def source_ids(mesh: Mesh, model: Model, view: OutputMesh) -> tuple[dict, dict]:
     """(point_data, cell_data) of a model file's numbers that ``mesh`` carries (an imported
-    mesh's :data:`~shellsim.foreign.shell_mesh.SOURCE_NODE` and ``SOURCE_ELEMENT``) on the
+    mesh's :data:`~shellsim.mesh.SOURCE_NODE` and ``SOURCE_ELEMENT``) on the
     view: a node's number at the points that are it (an element's corners; 0 elsewhere),
     an element's on each of its cells; empty where the mesh has none."""
-    from ..foreign.shell_mesh import SOURCE_ELEMENT, SOURCE_NODE
-
     points, cells = {}, {}
     if SOURCE_NODE in mesh.point_fields:
         points[SOURCE_NODE] = _at_corners(mesh.point_fields[SOURCE_NODE], model.conn, len(view.layers), CORNER_IS_NODE)

@@ -74,7 +74,8 @@ class SyntheticValve:
         s = np.linspace(0.0, 1.0, self.radial + 1)[:, None]
         theta = np.linspace(0.0, 2 * np.pi, self.ring, endpoint=False)[None]
         r = ANNULUS_RADIUS + (FREE_EDGE_RADIUS - ANNULUS_RADIUS) * s
-        return np.stack([r * np.cos(theta), r * np.sin(theta), -DEPTH * s + 0 * theta], axis=-1)
+        z = np.broadcast_to(-DEPTH * s, (len(s), self.ring))
+        return np.stack([r * np.cos(theta), r * np.sin(theta), z], axis=-1)
 
     @cached_property
     def shells(self) -> list[tuple[int, int, list[int]]]:

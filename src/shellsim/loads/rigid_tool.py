@@ -6,9 +6,11 @@ penalty.
 Each node of the contact set is tested on the faces it offers, the points
 y = x + t h/2 d (t = -1 bottom, +1 top, 0 the mid-surface), against the tool's signed
 distance phi(y) (positive on the side the shell belongs to). Where phi < 0 the face point
-is pushed out along the tool's normal n with the force -k phi n, which acts where the
-face is: on the node's translations and, through its lever arm t h/2, on its director
-(as a face pressure does). With ``friction`` mu, the face point's velocity relative to
+is pushed out along the tool's normal n with the force -k phi n (smoothed within
+TOUCHING h/2 of touching, :mod:`shellsim.loads.penalty_law`: without it a static solve
+cycled around the kink where a ring lay flat along a plate), which acts where the face
+is: on the node's translations and, through its lever arm t h/2, on its director (as a
+face pressure does). With ``friction`` mu, the face point's velocity relative to
 the tool, tangent to it, is opposed by mu times the push (:func:`add_friction`).
 
 The penalty is the soft constraint of explicit codes: each node's spring is
@@ -36,6 +38,8 @@ from ..curve_tables import factor, rate
 from ..element.frames import cross
 from ..element.tangent import moved_node
 from ..table_types import Name, Positive, Vec3, need_directions
+from . import penalty_law
+from .penalty_law import TOUCHING
 from .table import ContactTable
 from .tool_surface import read_tool, search_grid, signed_distance
 
@@ -259,8 +263,8 @@ def _node_forces(loads, m, centre, x, d, h, out, scratch):
     face = loads.faces[m, 0]
     while face <= loads.faces[m, 1]:
         arm, gap = _face_gap(loads, m, centre, (x, d, h), face, y, normal)
-        if gap < 0.0:
-            push = -loads.stiffness[m] * gap
+        push = penalty_law.push(loads.stiffness[m], -gap, TOUCHING * 0.5 * h)
+        if push > 0.0:
             for i in range(3):
                 f[i] += push * normal[i]
                 g[i] += arm * push * normal[i]
@@ -313,7 +317,8 @@ def add_friction(t, model, shape, loads, f, g, v, w):
         while face <= loads.faces[m, 1]:
             arm, gap = _face_gap(loads, m, centre, (x, d, shape.h[node]), face, y, normal)
             face += 2
-            if gap >= 0.0:
+            push = penalty_law.push(loads.stiffness[m], -gap, TOUCHING * 0.5 * shape.h[node])
+            if push == 0.0:
                 continue
             for i in range(3):  # the director's rate is -w1 e1 - w2 e2
                 slip[i] = v[node, i] - arm * (w[node, 0] * e1[i] + w[node, 1] * e2[i]) - moving * loads.motion[m, i]
@@ -323,7 +328,7 @@ def add_friction(t, model, shape, loads, f, g, v, w):
             speed = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
             if speed == 0.0:
                 continue
-            drag = min(loads.friction[m] * -loads.stiffness[m] * gap, loads.stick[m] * speed) / speed
+            drag = min(loads.friction[m] * push, loads.stick[m] * speed) / speed
             for i in range(3):
                 f[node, i] -= drag * slip[i]
                 g[node, i] -= arm * drag * slip[i]
@@ -343,7 +348,7 @@ def item_forces(t, model, shape, loads, out):
 def _clearance(t, model, shape, loads, m, scratch):
     """(gap, energy) of item m at time t: the least signed distance of the faces its node
     offers from the tool (+inf: a surface tool farther than its reach), and the energy
-    k gap^2 / 2 of its springs over the faces that overlap. scratch: (centre, y,
+    its springs store over the faces (:func:`shellsim.loads.penalty_law.stored`). scratch: (centre, y,
     normal) (3,)."""
     centre, y, normal = scratch
     node = loads.nodes[m]
@@ -353,8 +358,7 @@ def _clearance(t, model, shape, loads, m, scratch):
     while face <= loads.faces[m, 1]:
         gap = _face_gap(loads, m, centre, (shape.x[node], shape.d[node], shape.h[node]), face, y, normal)[1]
         least = min(least, gap)
-        if gap < 0.0:
-            energy += 0.5 * loads.stiffness[m] * gap * gap
+        energy += penalty_law.stored(loads.stiffness[m], -gap, TOUCHING * 0.5 * shape.h[node])
         face += 2
     return least, energy
 

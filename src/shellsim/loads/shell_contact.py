@@ -42,6 +42,8 @@ from ..array_copy import copy_into
 from ..bundles import Shape
 from ..errors import MeshError
 from ..table_types import Name, Positive
+from . import penalty_law
+from .penalty_law import TOUCHING
 from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
 from .table import ContactTable
 
@@ -81,11 +83,6 @@ CHUNKS = 64
 
 #: The most faces a node may overlap in the initial shape (those it never meets).
 IGNORED = 32
-
-#: The penalty's smoothing width as a share of the offset (h_y + h_p) / 2: the push
-#: starts this far before the faces touch (and an overlap of the initial shape within it
-#: is none).
-TOUCHING = 1e-3
 
 #: How much farther than the contact's reach the gaps are looked for (an output's, not
 #: the search's: the clearance up to about a thickness shows where faces come close).
@@ -366,15 +363,14 @@ def _pair_forces(x, h, loads, m, row, out, work):
     """out (10, 3): the force on contact node m and on the nine nodes of face row ``row``,
     the shape (x, h) given: the node pushed out along the normal by k times its depth d
     (the spring of the module's text), the face's nodes back by N_a times that. Within
-    the smoothing width w of touching the push is k (d + w)^2 / (4 w), so that it and its
-    derivative are continuous (the static tangent stays consistent and a body resting
-    on another has a stiffness before it penetrates); zero below d = -w."""
+    the smoothing width w of touching the push is :mod:`shellsim.loads.penalty_law`'s
+    (a body resting on another has a stiffness before it penetrates)."""
     depth, smoothing, spring = _pair_spring(x, h, loads, m, row, work)
     out[:] = 0.0
     if spring == 0.0:
         return
     N = work[1][0]
-    push = spring * depth if depth >= smoothing else spring * (depth + smoothing) ** 2 / (4.0 * smoothing)
+    push = penalty_law.push(spring, depth, smoothing)
     normal = work[0][2]
     for i in range(3):
         out[0, i] = push * normal[i]
@@ -497,8 +493,7 @@ def deepest(t, model, shape, loads):
 @njit(cache=True)
 def item_energies(t, model, shape, loads, out):
     """out (K,): the energy stored in each contact node's spring on the current shape, its
-    push integrated over the depth d: k (d + w)^3 / (12 w) within the smoothing width w,
-    (2/3) k w^2 + k (d^2 - w^2) / 2 past it."""
+    push integrated over the depth (:func:`shellsim.loads.penalty_law.stored`)."""
     shape = _at_initial_thickness(model, shape)
     if loads.nodes.shape[0] == 0:
         return
@@ -509,10 +504,7 @@ def item_energies(t, model, shape, loads, out):
         if loads.touches[m] < 0:
             continue
         depth, w, spring = _pair_spring(shape.x, shape.h, loads, m, loads.touches[m], work)
-        if depth < w:
-            out[m] = spring * (depth + w) ** 3 / (12.0 * w)
-        else:
-            out[m] = spring * (2.0 / 3.0 * w * w + 0.5 * (depth * depth - w * w))
+        out[m] = penalty_law.stored(spring, depth, w)
 
 
 @njit(cache=True)

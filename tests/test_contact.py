@@ -132,30 +132,14 @@ component = "z"
     assert np.abs(balance).max() <= 0.01 * energies[:, KINETIC].max()
 
 
-@pytest.mark.parametrize("plate", ["plane", "surface"])
-def test_a_ring_squeezed_between_two_plates_meets_the_thin_ring_solution(plate, tmp_path):
-    """A thin ring (R = 10, h = 0.1, nu = 0, a quarter with its symmetry planes) pressed by
-    a plate on its top, solved statically: the change of the loaded diameter is
-    (pi/4 - 2/pi) P R^3 / (E I) per unit length (Timoshenko, Strength of Materials I,
-    curved bars; Roark's Formulas, Table 9.2 case 1), P the plate's force per unit
-    length, at small deflection. Measured on 8 quadratic elements over the quarter (4 and
-    16 give the same to 1e-5): +0.17% at a diameter change of 0.2% of R, +0.05% at
-    0.04%, +0.78% at 1%: what is left is the geometric nonlinearity the linear solution
-    leaves out, vanishing with the deflection. The plate is the analytic plane or the
-    same plane as two triangles read from an STL file, moved by the static ramp: both
-    meet the solution alike."""
-    radius, h, E, length = 10.0, 0.1, 1.2e6, 1.0
-    if plate == "plane":
-        tool = f'shape = "plane"\npoint = [0.0, {radius + h / 2}, 0.0]\nnormal = [0.0, -1.0, 0.0]'
-    else:  # its triangles facing -y, the ring's side
-        import meshio
-
-        corners = np.array([[-2.0, 0.0, -1.0], [-2.0, 0.0, 2.0], [12.0, 0.0, 2.0], [12.0, 0.0, -1.0]])
-        meshio.write_points_cells(tmp_path / "plate.stl", corners, [("triangle", np.array([[0, 2, 1], [0, 3, 2]]))])
-        tool = f'shape = "surface"\nfile = "{(tmp_path / "plate.stl").as_posix()}"\npoint = [0.0, {radius + h / 2}, 0.0]'
-    text = deck_text(f'builder = "tube"\ninner_radius = {radius - h / 2}\nlength = {length}', f'''
+def ring_between_plates(tool: str, solver: str, h: float = 0.1, around: int = 8, E: float = 1.2e6) -> str:
+    """The deck of a ring (R = 10, length 1, nu = 0; a quarter, its symmetry planes held,
+    ``around`` elements over it) under a rigid plate on its top named 'plate' (``tool``:
+    its [[contact]] keys past the set), the top's displacement probed as 'top', solved by
+    the ``solver`` table."""
+    return deck_text(f'builder = "tube"\ninner_radius = {RING_RADIUS - h / 2}\nlength = 1.0', f'''
 [mesh]
-divisions = {{ around = 8, axial = 1 }}
+divisions = {{ around = {around}, axial = 1 }}
 [[boundary]]
 type = "symmetry"
 set = "sym_x"
@@ -173,25 +157,69 @@ type = "rigid_tool"
 name = "plate"
 set = "wall"
 {tool}
-motion = [0.0, -0.01, 0.0]
 [[output.probe]]
 name = "top"
 quantity = "displacement"
 set = "z0_y"
 component = "y"
-''').replace("E = 1000.0\nnu = 0.3", f"E = {E}\nnu = 0.0").replace("thickness = 0.01", f"thickness = {h}")
-    text = text.replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }')
-    run = run_deck(parse_deck(text))
+''').replace("E = 1000.0\nnu = 0.3", f"E = {E}\nnu = 0.0").replace("thickness = 0.01", f"thickness = {h}").replace(
+        "[solver]\nend_time = 1.0", solver)
+
+
+#: The rings' radius.
+RING_RADIUS = 10.0
+
+
+def plane_above(h: float) -> str:
+    """A rigid plane touching the top of a ring of thickness h, facing it."""
+    return f'shape = "plane"\npoint = [0.0, {RING_RADIUS + h / 2}, 0.0]\nnormal = [0.0, -1.0, 0.0]'
+
+
+def crushed_against_elastica(run, h: float, E: float = 1.2e6):
+    """(approach (m,), the plate's force per unit length over the elastica's (m,)) of a
+    ring run of :func:`ring_between_plates` at its samples past 5% of the radius."""
+    from shellsim.verify.elastica import load_at, load_path
+
+    approach = -2.0 * np.asarray(run.history["top"])  # of the mid-surfaces, both plates
+    load = 2.0 * np.asarray(run.history["plate"])  # the quarter carries half the plate's load, per unit length
+    measured = approach > 0.05 * RING_RADIUS
+    path = load_path(20, approach.max() / RING_RADIUS + 0.05)
+    return approach[measured], load[measured] / load_at(approach[measured], RING_RADIUS, E * h**3 / 12, path)
+
+
+@pytest.mark.parametrize("plate", ["plane", "surface"])
+def test_a_ring_squeezed_between_two_plates_meets_the_thin_ring_solution(plate, tmp_path):
+    """A thin ring (R = 10, h = 0.1, nu = 0, a quarter with its symmetry planes) pressed by
+    a plate on its top, solved statically: the change of the loaded diameter is
+    (pi/4 - 2/pi) P R^3 / (E I) per unit length (Timoshenko, Strength of Materials I,
+    curved bars; Roark's Formulas, Table 9.2 case 1), P the plate's force per unit
+    length, at small deflection. Measured on 8 quadratic elements over the quarter (4 and
+    16 give the same to 1e-5): +0.17% at a diameter change of 0.2% of R, +0.05% at
+    0.04%, +0.78% at 1%: what is left is the geometric nonlinearity the linear solution
+    leaves out, vanishing with the deflection. The plate is the analytic plane or the
+    same plane as two triangles read from an STL file, moved by the static ramp: both
+    meet the solution alike."""
+    h, E = 0.1, 1.2e6
+    if plate == "plane":
+        tool = plane_above(h)
+    else:  # its triangles facing -y, the ring's side
+        import meshio
+
+        corners = np.array([[-2.0, 0.0, -1.0], [-2.0, 0.0, 2.0], [12.0, 0.0, 2.0], [12.0, 0.0, -1.0]])
+        meshio.write_points_cells(tmp_path / "plate.stl", corners, [("triangle", np.array([[0, 2, 1], [0, 3, 2]]))])
+        tool = (f'shape = "surface"\nfile = "{(tmp_path / "plate.stl").as_posix()}"\n'
+                f'point = [0.0, {RING_RADIUS + h / 2}, 0.0]')
+    solver = '[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full" }'
+    run = run_deck(parse_deck(ring_between_plates(f"{tool}\nmotion = [0.0, -0.01, 0.0]", solver, h=h, E=E)))
     diameter_change = -2.0 * run.history["top"][-1]
-    load = 2.0 * run.history["plate"][-1] / length  # the quarter carries half the plate's load
-    inertia = h**3 / 12
-    expected = (np.pi / 4 - 2 / np.pi) * load * radius**3 / (E * inertia)
-    assert 0.0 < diameter_change < 0.003 * radius
+    load = 2.0 * run.history["plate"][-1]  # the quarter carries half the plate's load, per unit length
+    expected = (np.pi / 4 - 2 / np.pi) * load * RING_RADIUS**3 / (E * h**3 / 12)
+    assert 0.0 < diameter_change < 0.003 * RING_RADIUS
     assert diameter_change / expected == pytest.approx(1.0, abs=0.005)
 
 
 def test_a_ring_crushed_to_half_its_diameter_follows_the_elastica_through_its_flat_phase():
-    """The ring of the test above (a quarter, R = 10, h = 0.1, 16 quadratic elements) crushed
+    """The ring of the test above (16 quadratic elements over the quarter) crushed
     statically until the plates have approached by 52% of its diameter: past 28% the ring
     lies flat along the plates over a growing length. The plates' force per unit length
     against their approach is the inextensible elastica's
@@ -199,50 +227,44 @@ def test_a_ring_crushed_to_half_its_diameter_follows_the_elastica_through_its_fl
     step, the flat phase included. Measured: within 0.01% up to the flat phase, 0.34% at
     most after it (the flat zone's edge moving from node to node); with a kinked penalty
     (push -k gap, no smoothing) load control stopped at 36% of the diameter."""
-    from shellsim.verify.elastica import flat_phase_start, load_at, load_path
+    from shellsim.verify.elastica import flat_phase_start
 
-    radius, h, E, length, travel = 10.0, 0.1, 1.2e6, 1.0, 5.2
-    text = deck_text(f'builder = "tube"\ninner_radius = {radius - h / 2}\nlength = {length}', f'''
-[mesh]
-divisions = {{ around = 16, axial = 1 }}
-[[boundary]]
-type = "symmetry"
-set = "sym_x"
-normal = [1.0, 0.0, 0.0]
-[[boundary]]
-type = "symmetry"
-set = "sym_y"
-normal = [0.0, 1.0, 0.0]
-[[boundary]]
-type = "symmetry"
-set = "z0"
-normal = [0.0, 0.0, 1.0]
-[[contact]]
-type = "rigid_tool"
-name = "plate"
-set = "wall"
-shape = "plane"
-point = [0.0, {radius + h / 2}, 0.0]
-normal = [0.0, -1.0, 0.0]
-motion = [0.0, -{travel}, 0.0]
-[[output.probe]]
-name = "top"
-quantity = "displacement"
-set = "z0_y"
-component = "y"
-''').replace("E = 1000.0\nnu = 0.3", f"E = {E}\nnu = 0.0").replace("thickness = 0.01", f"thickness = {h}")
-    text = text.replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0\n'
-                                                     'static = { newton = "full", increments = 20 }')
-    run = run_deck(parse_deck(text))
-    approach = -2.0 * np.asarray(run.history["top"])  # of the mid-surfaces, both plates
-    load = 2.0 * np.asarray(run.history["plate"]) / length
-    bending = E * h**3 / 12
-    assert run.times[-1] == 1.0 and approach[-1] > 1.0 * radius  # half the diameter, and on
-    measured = approach > 0.05 * radius
-    expected = load_at(approach[measured], radius, bending, load_path(20, approach.max() / radius + 0.05))
-    flat = approach[measured] > flat_phase_start() * radius
-    assert flat.sum() >= 10  # well into the flat phase
-    assert load[measured] / expected == pytest.approx(1.0, abs=0.005)
+    h = 0.1
+    solver = '[solver]\nmethod = "static"\nend_time = 1.0\nstatic = { newton = "full", increments = 20 }'
+    run = run_deck(parse_deck(ring_between_plates(f"{plane_above(h)}\nmotion = [0.0, -5.2, 0.0]", solver, h=h,
+                                                  around=16)))
+    approach, ratio = crushed_against_elastica(run, h)
+    assert run.times[-1] == 1.0 and approach[-1] > RING_RADIUS  # half the diameter, and on
+    assert (approach > flat_phase_start() * RING_RADIUS).sum() >= 10  # well into the flat phase
+    assert ratio == pytest.approx(1.0, abs=0.005)
+
+
+def test_a_ring_crushed_by_a_moving_plate_comes_to_rest_explicitly_on_the_elastica():
+    """The ring, thickened to h = 0.5 (R / h = 20), crushed explicitly by the plate moving
+    down a quarter of the diameter over 4 s (about 2.7 periods of its slowest mode) and
+    then held, with kinetic damping ([solver.relaxation]): the velocities are reset only
+    once the plate has stopped, as a reset while it moves stops the nodes it pushes and
+    it runs into them (with resets all along, this ring folded 9 elements just after the
+    push). The ring comes to rest with the plates' force on the elastica's at
+    its approach: measured +0.01% at 52% of the diameter, at rest 0.19 s after the plate
+    stopped, 8 resets."""
+    h = 0.5
+    solver = """[solver]
+end_time = 8.0
+[solver.relaxation]
+residual = 1e-4
+[curves.push]
+t = [0.0, 4.0, 8.0]
+value = [0.0, 1.0, 1.0]
+interpolate = "smooth"
+"""
+    run = run_deck(parse_deck(ring_between_plates(f'{plane_above(h)}\nmotion = [0.0, -2.6, 0.0]\ncurve = "push"',
+                                                  solver, h=h, around=16)))
+    relaxed = run.relaxing.record(run.sim)
+    assert relaxed["relaxed_at"] is not None and relaxed["held_from"] == 4.0 and relaxed["resets"] >= 1
+    approach, ratio = crushed_against_elastica(run, h)
+    assert approach[-1] == pytest.approx(0.52 * RING_RADIUS, abs=0.01 * RING_RADIUS)
+    assert ratio[-1] == pytest.approx(1.0, abs=0.003)
 
 
 @pytest.mark.parametrize(("keys", "expected"), [

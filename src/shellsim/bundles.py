@@ -135,8 +135,8 @@ class Model(NamedTuple):
     rule, mesh, material, loads, curves and supports, and the initial shape (n nodes):
     x0, d0 (n, 3) mid-surface and directors, e1f0 (n, 3) fibre-frame first axes;
     mass 'M1' or 'M2' (thesis 3.14); damping [1/s]
-    (mass-proportional); kinetic_damping: every velocity set to zero at each peak of the
-    kinetic energy (dynamic relaxation)."""
+    (mass-proportional); relax_from: the time from which every velocity is set to zero
+    at each peak of the kinetic energy (dynamic relaxation; inf: never)."""
 
     rule: Rule
     body: Body
@@ -149,7 +149,7 @@ class Model(NamedTuple):
     e1f0: np.ndarray
     mass: str
     damping: float
-    kinetic_damping: bool
+    relax_from: float
 
     @property
     def h0(self) -> np.ndarray:

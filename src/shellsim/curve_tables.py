@@ -3,8 +3,12 @@ and the time loop read factors through the same function."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
+
+from .bundles import Curves
 
 #: Codes of a table's interpolation and extrapolation.
 INTERPOLATION = {"linear": 0, "step": 1, "smooth": 2, "smooth_step": 3}
@@ -70,3 +74,20 @@ def rate(curves, index, time):
     n = curves.length[index]
     step = 1e-6 * (curves.t[index, n - 1] - curves.t[index, 0])
     return (factor(curves, index, time + step) - factor(curves, index, time - step)) / (2.0 * step)
+
+
+def held_from(curves: Curves, which=None) -> float:
+    """The time from which every curve of ``curves`` (or those of the indices ``which``)
+    holds its value: the latest of their last changes (0 for none; inf when one is
+    extrapolated linearly past a change)."""
+    latest = 0.0
+    for c in range(len(curves.length)) if which is None else which:
+        n = int(curves.length[c])
+        t, v = curves.t[c, :n], curves.v[c, :n]
+        changes = np.flatnonzero(v[1:] != v[:-1])
+        if not changes.size:
+            continue
+        if curves.extrap[c] == EXTRAPOLATION["linear"] and changes[-1] == n - 2:
+            return math.inf
+        latest = max(latest, float(t[changes[-1] + 1]))
+    return latest

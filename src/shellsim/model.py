@@ -10,10 +10,12 @@ the plane's normal, whose rotation is fixed). Loads become the tables of their k
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .bundles import Body, Constraints, Curves, Material, Model, Prescribed, Rule, Shape, slots_by_node
-from .curve_tables import EXTRAPOLATION, INTERPOLATION
+from .curve_tables import EXTRAPOLATION, INTERPOLATION, held_from
 from .deck import Deck
 from .errors import MeshError, id_list, place
 from .element.frames import initial_fibre_frame
@@ -97,8 +99,19 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
     return Model(
         rule=rule, body=body, material=_material(deck, mesh, rule, part), loads=loads, curves=curves,
         constraints=constraints, x0=mesh.x.copy(), d0=mesh.director.copy(), e1f0=e1f0, mass=deck.solver.mass, damping=deck.solver.damping,
-        kinetic_damping=deck.solver.relaxation is not None,
+        relax_from=relax_from(deck, curves),
     )
+
+
+def relax_from(deck: Deck, curves) -> float:
+    """When kinetic damping starts (inf: the deck relaxes nothing): once every rigid tool
+    that moves has stopped. A reset stops the nodes a tool is pushing while it goes on:
+    it then runs into them, and the penalty's impulse folded a crushed ring's elements."""
+    if deck.solver.relaxation is None:
+        return math.inf
+    moving = [deck.curve_index(tool.curve) for tool in deck.contact
+              if tool.type == "rigid_tool" and any(tool.motion) and tool.curve is not None]
+    return held_from(curves, moving)
 
 
 def element_parts(deck: Deck, mesh: Mesh) -> np.ndarray:

@@ -269,7 +269,10 @@ class MassScaling(Section):
 class Relaxation(Section):
     """``[solver.relaxation]``: dynamic relaxation by kinetic damping, for an explicit run
     whose answer is the state of rest. Whenever the kinetic energy has passed a peak,
-    every velocity is set to zero (the energy taken counted as damping work). Once every
+    every velocity is set to zero (the energy taken counted as damping work); where a
+    rigid tool moves on a curve, only once every such tool has stopped (a reset stops the
+    nodes a moving tool pushes, and it runs into them: a crushed ring folded so), the
+    deck's ``damping`` acting before. Once every
     curve holds its last value, the run ends at the first history sample whose residual
     force (over the free DOFs) is within ``residual`` of the larger of the external and
     internal force norms, as a static step converges; ``relaxation`` in summary.json

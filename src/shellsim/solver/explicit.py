@@ -253,7 +253,7 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
         work_int = 0.0
         work_fr = 0.0
         kinetic = update_velocities(fields, projector, rot_free, c, dt_avg)
-        if model.kinetic_damping:
+        if t >= model.relax_from:
             kinetic = kinetic_damping(v, w, mt, mr, kinetic, work, space.relax)
         for p in range(prescribed.nodes.shape[0]):
             node, i = prescribed.nodes[p], prescribed.axes[p]

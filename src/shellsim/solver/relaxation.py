@@ -5,29 +5,10 @@ is within the deck's tolerance, measured as a static step's is."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from ..bundles import Curves
-from ..curve_tables import EXTRAPOLATION
+from ..curve_tables import held_from
 from .equilibrium import Equilibrium
-
-
-def held_from(curves: Curves) -> float:
-    """The time from which every curve of ``curves`` holds its value: the latest of their
-    last changes (0 for none; inf when one is extrapolated linearly past a change)."""
-    latest = 0.0
-    for c in range(len(curves.length)):
-        n = int(curves.length[c])
-        t, v = curves.t[c, :n], curves.v[c, :n]
-        changes = np.flatnonzero(v[1:] != v[:-1])
-        if not changes.size:
-            continue
-        if curves.extrap[c] == EXTRAPOLATION["linear"] and changes[-1] == n - 2:
-            return math.inf
-        latest = max(latest, float(t[changes[-1] + 1]))
-    return latest
 
 
 class Relaxing:

@@ -41,6 +41,10 @@ and, when it has kernels of its own,
   ``farthest_moved(t, model, shape, bundle, before)``, of those near a face the one that
   moved farthest relative to it since the positions ``before`` (n, 3), by what share of
   its distance from the face;
+- where it pairs each contact node with a face found by a search: ``hold_pairs(bundle,
+  holding)``, the pairs of the last evaluation held (or searched again), and
+  ``pairs(bundle)``, each contact node's face at the last evaluation (a copy; -1: none),
+  for the Newton iterations of a static or implicit step;
 - where its forces couple nodes that share no element (contact between shells, cables):
   compiled ``couplings(t, model, shape, bundle, step_u, nodes, blocks)``, the derivative
   of its forces by groups of ten nodes' translations (nodes (K, 10), blocks (K, 30, 30),
@@ -166,6 +170,25 @@ def overlaps_at_rest(model, contacts: list) -> list[str]:
     per contact table of the deck's ``contacts``)."""
     return [line for kind, bundle in _with(model, "overlaps_at_rest")
             for line in kind.overlaps_at_rest(bundle, contacts, model.x0)]
+
+
+def hold_pairs(model, holding: bool) -> None:
+    """Hold every contact node to the face it touched at the last evaluation, or search
+    again at each (``holding`` false), for every kind that pairs nodes with faces."""
+    for kind, bundle in _with(model, "hold_pairs"):
+        kind.hold_pairs(bundle, holding)
+
+
+def contact_pairs(model) -> list[np.ndarray]:
+    """Each pairing kind's (K,) face row of each contact node at the last evaluation (-1:
+    none), copies."""
+    return [kind.pairs(bundle) for kind, bundle in _with(model, "pairs")]
+
+
+def pairs_added(model, before: list[np.ndarray]) -> int:
+    """How many contact nodes touch a face at the last evaluation that touched none in
+    ``before`` (:func:`contact_pairs`)."""
+    return sum(int(np.count_nonzero((now >= 0) & (then < 0))) for now, then in zip(contact_pairs(model), before))
 
 
 def needs_calibration(model) -> bool:

@@ -20,11 +20,12 @@ ROLES = {
     "load": ((), ("Bundle", "add_forces", "empty", "add_tangent", "couplings")),
     "contact": ((*CARRYING, "calibrate", "step_share", "item_forces", "item_energies", "item_gaps", "FORCE_TOTAL",
                  "SIDES"),
-                ("add_tangent", "add_friction", "deepest", "farthest_moved", "couplings", "empty", "overlaps_at_rest")),
+                ("add_tangent", "add_friction", "deepest", "farthest_moved", "couplings", "empty", "overlaps_at_rest",
+                 "hold_pairs", "pairs")),
     "cable": ((*CARRYING, "extend_mesh", "add_masses", "critical_step"), ("add_tangent", "couplings", "empty")),
 }
 #: Hooks that come together or not at all.
-PAIRS = (("deepest", "farthest_moved"),)
+PAIRS = (("deepest", "farthest_moved"), ("hold_pairs", "pairs"))
 #: What a role's deck table must have beyond its keys: the line ``shellsim check`` prints.
 TABLE_HOOKS = {"load": (), "contact": ("summary",), "cable": ("summary", "elements", "declared_sets")}
 #: How close a name of the kind's must be to a hook it lacks to be taken for a misspelling.

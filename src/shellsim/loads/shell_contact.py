@@ -101,7 +101,9 @@ class Bundle(NamedTuple):
     offset, penalty, friction (K,): the table's; spring (K,): s / dt_c^2 and
     inverse_mass (K,): 1/m (0 until :func:`calibrate`); ignored (K, :data:`IGNORED`): the elements whose
     faces the node overlaps in the initial shape (-1 after the last), and initial_depth
-    (K,) how deep it is into the deepest of them [length] (0: none). faces (F, 9): each
+    (K,) how deep it is into the deepest of them [length] (0: none); held (K,) each
+    contact node's face row while the pairs are held (:func:`hold_pairs`; -1: none) and
+    holding (1,) whether they are (1) or searched at every evaluation (0). faces (F, 9): each
     face's nodes; face_elements (F,) their elements; face_group (F,);
     face_inverse_mass (F, 9) (0 until :func:`calibrate`). Scratch: touches (K,) each
     contact node's face row (-1: none) and touch_forces (K, 10, 3) the forces on it and
@@ -118,6 +120,8 @@ class Bundle(NamedTuple):
     inverse_mass: np.ndarray
     ignored: np.ndarray
     initial_depth: np.ndarray
+    held: np.ndarray
+    holding: np.ndarray
     faces: np.ndarray
     face_elements: np.ndarray
     face_group: np.ndarray
@@ -164,6 +168,7 @@ def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> 
         offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), friction=np.full(k, table.friction),
         spring=np.zeros(k),
         inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64), initial_depth=np.zeros(k),
+        held=np.full(k, -1, dtype=np.int64), holding=np.zeros(1, dtype=np.int64),
         faces=conn[elements].astype(np.int64).reshape(-1, 9), face_elements=elements,
         face_group=joined([np.full(len(e), 2 * place + i) for i, (_, e) in enumerate(passes)]),
         face_inverse_mass=np.zeros((f, 9)), touches=np.full(k, -1, dtype=np.int64),
@@ -283,6 +288,22 @@ def _candidates(shape, loads, m, grid, work, ignoring):
     return best
 
 
+def hold_pairs(loads: Bundle, holding: bool) -> None:
+    """Hold each contact node to the face it touched at the last evaluation (and a node
+    touching none to none), or search again at every evaluation (``holding`` false). A
+    Newton step's iterations hold them once they have settled: where three leaflets meet,
+    a node's deepest face flipped between two from one iterate to the next, and the
+    residual with it, for as long as the iterations ran."""
+    if holding and not loads.holding[0]:
+        loads.held[:] = loads.touches
+    loads.holding[0] = int(holding)
+
+
+def pairs(loads: Bundle) -> np.ndarray:
+    """(K,) each contact node's face row at the last evaluation (-1: none), a copy."""
+    return loads.touches.copy()
+
+
 def overlaps_at_rest(loads: Bundle, tables: list, x: np.ndarray) -> list[str]:
     """One line per contact table whose nodes overlap faces in the initial shape (x (n, 3)):
     how many nodes, the deepest overlap and where; those faces are never pushed against."""
@@ -392,10 +413,11 @@ def _contact_forces(model, shape, loads):
 
 @njit(cache=True)
 def _contact_chunk(first, stop, shape, loads, grid):
-    """:func:`_contact_forces` of contact nodes first..stop-1."""
+    """:func:`_contact_forces` of contact nodes first..stop-1 (the held pairs' faces while
+    they are held)."""
     work = _work()
     for m in range(first, stop):
-        row = _touched(shape, loads, m, grid, work)
+        row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
         loads.touches[m] = row
         if row >= 0:
             _pair_forces(shape.x, shape.h, loads, m, row, loads.touch_forces[m], work)
@@ -578,7 +600,7 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
     """The derivative of each touching pair's forces with respect to its ten nodes'
     translations (central differences of step ``step_u``; the pair and the fibre lengths
     held): nodes (K, 10) the node numbers and blocks (K, 30, 30) dF/dx, filled from the
-    top. Returns how many pairs touch."""
+    top. Returns how many pairs touch (or are held)."""
     shape = _at_initial_thickness(model, shape)
     grid = _grid(shape, loads, 1.0)
     work = _work()
@@ -586,7 +608,7 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
     x = shape.x
     count = 0
     for m in range(loads.nodes.shape[0]):
-        row = _touched(shape, loads, m, grid, work)
+        row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
         if row < 0:
             continue
         nodes[count, 0] = loads.nodes[m]

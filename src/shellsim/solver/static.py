@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import NumericalError, id_list, place
-from ..loads import passed_through
+from ..loads import contact_pairs, hold_pairs, pairs_added, passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, output_times, take_frame, take_sample
@@ -49,6 +49,12 @@ RUNAWAY = 1e6
 #: tangent's prediction) jumped: load control passes a small snap-through so, landing on
 #: another part of the path without following it.
 JUMP = 10.0
+#: Iterations of a step after which each contact node is held to the face it touches
+#: then, for the rest of the step: a node's nearest face can flip between two from one
+#: iterate to the next (where three leaflets meet), and the residual with it for as long
+#: as the iterations run. Converged so, the faces are searched again: the step is done
+#: unless a node has come to touch a face it did not (then it goes on with those).
+PAIRS_HELD_AFTER = 4
 
 
 @dataclass
@@ -188,7 +194,10 @@ class NewtonSolver:
         # a wild iterate (an exponential law far out) has forces whose squares overflow: it is
         # no equilibrium, and is gone back from or cut back, so numpy need not warn of it
         with np.errstate(over="ignore", invalid="ignore"):
-            return self._iterate(t, line_search)
+            try:
+                return self._iterate(t, line_search)
+            finally:
+                hold_pairs(self.run.model, False)
 
     def _iterate(self, t: float, line_search: bool) -> tuple[int, int, float]:
         """:meth:`step`'s iterations."""
@@ -198,7 +207,11 @@ class NewtonSolver:
         pending = known  # the prescribed moves, made with the first correction
         first_energy, previous, before, tangents, fresh = None, np.inf, None, 0, False
         predicted = np.inf  # how far the first correction moved the nodes (JUMP's measure)
+        held, hold_at = None, PAIRS_HELD_AFTER  # the contact pairs held (PAIRS_HELD_AFTER), and from when
         for iteration in range(settings.max_iterations + 1):
+            if iteration == hold_at:
+                hold_pairs(self.run.model, True)
+                held = contact_pairs(self.run.model) or None  # None: the scene pairs nothing
             residual = self.free_residual()
             scale = eq.force_scale()
             norm = float(np.linalg.norm(residual))
@@ -211,7 +224,17 @@ class NewtonSolver:
                 energy = abs(float(self.tangent[1].solve(residual) @ residual))
                 stalled = fresh and norm > SLOW * previous
                 ran_away = scale > RUNAWAY * start_scale
-                if not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2], stalled):
+                converged = not ran_away and self.converged(norm, scale, energy, first_energy, self.tangent[2],
+                                                            stalled)
+                if converged and held is not None:  # search the faces again
+                    hold_pairs(self.run.model, False)
+                    eq.evaluate(t)
+                    if pairs_added(self.run.model, held):  # new contacts: on with them, a new tangent
+                        held, hold_at = None, iteration + PAIRS_HELD_AFTER
+                        residual = self.free_residual()
+                        norm, previous, before, self.tangent = float(np.linalg.norm(residual)), np.inf, None, None
+                        converged = False
+                if converged:
                     self.held_apart(t)
                     moved = self._moved()
                     if moved > JUMP * predicted and self.eq.inertia is None:

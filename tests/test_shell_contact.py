@@ -357,6 +357,46 @@ def test_held_pairs_keep_each_node_on_its_face_until_released(tmp_path):
     assert pushing(0.3) == len(upper) and pairs_added(model, before) == 0
 
 
+def test_a_plate_between_two_others_in_one_self_contact_is_pushed_from_both_sides(tmp_path):
+    """Three like plates built stacked, then each moved 0.002 into the next, in one
+    self-contact table over all three (as one table over a valve's three leaflets): a
+    node of the middle plate touches a face of each of the other two and pushes both, so
+    the middle plate, pressed equally from above and below, takes no net force, and the
+    top and bottom plates take equal and opposite ones. With one face a node, the
+    middle's nodes pushed only one (and this failed)."""
+    from shellsim.bundles import Shape
+    from shellsim.loads import calibrate
+    from shellsim.mesh import Mesh
+    from shellsim.model import build_model
+
+    h, overlap = 0.01, 0.002
+    plates = []
+    for level in range(3):
+        plate = build_mesh(parse_deck(deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 1.0',
+                                                "[mesh]\ndivisions = { length = 3, width = 3 }\n")))
+        plate.x[:, 2] += level * h  # built touching: overlaps at rest would be ignored
+        plates.append(plate)
+    n, e = plates[0].n_nodes, plates[0].n_elements
+    sets = {name: NamedSet("surface", np.arange(level * n, (level + 1) * n),
+                           elements=np.arange(level * e, (level + 1) * e))
+            for level, name in enumerate(("lower", "middle", "upper"))}
+    sets["stack"] = NamedSet("surface", np.arange(3 * n), elements=np.arange(3 * e))
+    path = tmp_path / "stack.vtu"
+    write_mesh_vtu(Mesh(x=np.vstack([p.x for p in plates]), conn=np.vstack([p.conn + i * n for i, p in enumerate(plates)]),
+                        director=np.vstack([p.director for p in plates]), thickness=np.full(3 * n, h), sets=sets), path)
+    deck = parse_deck(deck_text(f'builder = "file"\npath = "{path.as_posix()}"',
+                                '[[contact]]\ntype = "shells"\nname = "stacked"\nset = "stack"\n'))
+    model = build_model(deck, build_mesh(deck))
+    calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
+    x = model.x0.copy()
+    x[:, 2] -= overlap * np.repeat(np.arange(3), n)
+    forces = ToolForces(model, ["stacked"]).at_nodes(0.0, Shape(x=x, d=model.d0.copy(), e1=model.e1f0.copy(),
+                                                                  h=model.h0.copy()))
+    lower, middle, upper = (forces[sets[name].nodes, 2].sum() for name in ("lower", "middle", "upper"))
+    assert upper > 0.0 and lower == pytest.approx(-upper, rel=1e-12)
+    assert abs(middle) <= 1e-12 * upper
+
+
 def test_the_contact_forces_on_two_plates_are_action_and_reaction(tmp_path):
     """Every contact force on a node of one plate comes with its opposite on the other's:
     the nodal contact forces (the output field's) sum to zero."""

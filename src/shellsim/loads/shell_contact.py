@@ -36,7 +36,9 @@ from __future__ import annotations
 from typing import Literal, NamedTuple
 
 import numpy as np
+import scipy.sparse as sp
 from numba import njit, prange
+from scipy.sparse.csgraph import connected_components
 
 from ..array_copy import copy_into
 from ..bundles import Shape
@@ -80,6 +82,11 @@ TABLES = (ShellContact,)
 #: The contact nodes are searched in this many chunks shared among the threads (a count
 #: the compiled code may not read from the threading layer and still be cached).
 CHUNKS = 64
+
+#: The most separate surfaces of a self-contact's set taken each against each (more are
+#: taken as one surface, each node with one face), and the passes a table may have.
+MOST_SURFACES = 16
+PASSES = MOST_SURFACES**2
 
 #: The most faces a node may overlap in the initial shape (those it never meets).
 IGNORED = 32
@@ -137,11 +144,17 @@ class Bundle(NamedTuple):
 def build(table: ShellContact, scene) -> Bundle:
     """One table's contact: the nodes of its set against the faces of the other, and (a
     pair) the other's nodes against the set's faces; each node's faces it overlaps in
-    the initial shape found once."""
+    the initial shape found once. A set of a few separate surfaces (three leaflets)
+    in self-contact is taken as every surface's nodes against each surface's faces, so
+    that a node may touch a face of each (where three leaflets meet, a node with one
+    face flipped between the other two leaflets' and pushed only one of them)."""
     sets = scene.mesh.sets
     mine = sets[table.set]
     if table.against is None:
-        passes = [(mine.nodes, mine.elements)]
+        surfaces = _surfaces(mine.elements, scene.mesh.conn)
+        if not 1 < len(surfaces) <= MOST_SURFACES:
+            surfaces = [mine.elements]
+        passes = [(np.unique(scene.mesh.conn[nodes_of]), faces_of) for nodes_of in surfaces for faces_of in surfaces]
     else:
         theirs = sets[table.against]
         passes = [(mine.nodes, theirs.elements), (theirs.nodes, mine.elements)]
@@ -153,9 +166,19 @@ def build(table: ShellContact, scene) -> Bundle:
     return loads
 
 
+def _surfaces(elements: np.ndarray, conn: np.ndarray) -> list[np.ndarray]:
+    """The ``elements`` (f,) as the separate surfaces they make (joined through shared
+    nodes), each its elements."""
+    rows = np.repeat(np.arange(len(elements)), conn.shape[1])
+    incidence = sp.csr_matrix((np.ones(len(rows)), (rows, conn[elements].ravel())),
+                              shape=(len(elements), conn.max() + 1))
+    count, labels = connected_components(incidence @ incidence.T, directed=False)
+    return [elements[labels == label] for label in range(count)]
+
+
 def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> Bundle:
     """A :class:`Bundle` of one table's passes, each (nodes (k,), elements (f,)) whose faces
-    the nodes meet, group 2 place + the pass."""
+    the nodes meet, group ``PASSES`` place + the pass."""
     def joined(parts, dtype=np.int64):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype=dtype)
 
@@ -164,13 +187,13 @@ def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> 
     k, f = len(nodes), len(elements)
     return Bundle(
         nodes=nodes, tool=np.full(k, place, dtype=np.int64),
-        group=joined([np.full(len(n), 2 * place + i) for i, (n, _) in enumerate(passes)]),
+        group=joined([np.full(len(n), PASSES * place + i) for i, (n, _) in enumerate(passes)]),
         offset=np.full(k, table.offset), penalty=np.full(k, table.penalty), friction=np.full(k, table.friction),
         spring=np.zeros(k),
         inverse_mass=np.zeros(k), ignored=np.full((k, IGNORED), -1, dtype=np.int64), initial_depth=np.zeros(k),
         held=np.full(k, -1, dtype=np.int64), holding=np.zeros(1, dtype=np.int64),
         faces=conn[elements].astype(np.int64).reshape(-1, 9), face_elements=elements,
-        face_group=joined([np.full(len(e), 2 * place + i) for i, (_, e) in enumerate(passes)]),
+        face_group=joined([np.full(len(e), PASSES * place + i) for i, (_, e) in enumerate(passes)]),
         face_inverse_mass=np.zeros((f, 9)), touches=np.full(k, -1, dtype=np.int64),
         touch_forces=np.zeros((k, 10, 3)), reach=np.zeros(f), boxes=np.zeros((f, 6)),
         start=np.zeros(2 * f + 1 if f else 0, dtype=np.int64), entries=np.zeros(8 * f, dtype=np.int64))

@@ -16,7 +16,7 @@ from shellsim.study.jobs import variant_deck
 from .conftest import ROOT
 
 VALVES = ROOT / "decks" / "valves"
-COARSE = {"mesh.divisions": {"around": 8, "belly": 4, "coaptation": 2}}
+COARSE = {"mesh.divisions": {"around": 8, "belly": 4, "coaptation": 2}, "solver.implicit.increments": 40}
 #: The deck's reference on the orifice, and one on its least value over the run (read from
 #: the samples measured: the history between them holds nan).
 REFERENCES = [{"quantity": "orifice area", "probe": "orifice_area", "measure": measure, "expected": 0.0,
@@ -26,8 +26,8 @@ REFERENCES = [{"quantity": "orifice area", "probe": "orifice_area", "measure": m
 
 @pytest.fixture(scope="module")
 def closing(tmp_path_factory):
-    """(run, folder): the closing valve on 8 x 6 elements a leaflet (144 in all), with its
-    renders."""
+    """(run, folder): the closing valve on 8 x 6 elements a leaflet (144 in all), in
+    steps of 2 ms, with its renders."""
     from shellsim.output.render import deck_renders
     from shellsim.execute import run_scene
 
@@ -61,7 +61,8 @@ def test_the_closed_valve_s_measures_are_a_closed_valve_s(closing):
     """The valve's measures in summary.json: the widest opening a lone pixel's (twice its
     distance to a covered one, 2 pixels of the raster's 400 across the annulus); the leaflets coapting over a band at the
     centre (coaptation height between the builder's band, 2 mm, and the valve's height,
-    14 mm); and every measure sampled. The peak principal stress is at least the
+    14 mm); and every measure sampled (at 200 evenly spaced times, or at every step of a
+    run of fewer). The peak principal stress is at least the
     attachment's mean: the pressure's push on the annulus' inside, p A, reaches the root
     only through the leaflets' tension along the attachment, of length L, so some point
     there carries p A / (L h) or more."""
@@ -77,7 +78,7 @@ def test_the_closed_valve_s_measures_are_a_closed_valve_s(closing):
     length = np.linalg.norm(np.diff(edges, axis=1), axis=2).sum()
     assert valve["peak_principal_stress"]["final"] > 0.010666 * area / (length * run.deck.section.thickness)
     history = np.genfromtxt(folder / "history.csv", delimiter=",", names=True)
-    assert np.count_nonzero(~np.isnan(history["orifice_area"])) >= 200
+    assert np.count_nonzero(~np.isnan(history["orifice_area"])) >= min(200, len(history))
 
 
 def test_the_closed_valve_is_drawn_with_its_contact_pressure_and_stress_and_its_measures_plotted(closing):

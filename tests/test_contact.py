@@ -218,6 +218,19 @@ def test_a_ring_squeezed_between_two_plates_meets_the_thin_ring_solution(plate, 
     assert diameter_change / expected == pytest.approx(1.0, abs=0.005)
 
 
+def test_the_elastica_reference_tends_to_the_thin_ring_solution_as_the_load_vanishes():
+    """The elastica of :mod:`shellsim.verify.elastica` under a small load P (R = EI = 1)
+    is the linear thin ring's: an approach of (pi/4 - 2/pi) P, which it exceeds by a
+    geometric nonlinearity proportional to the load (2.3e-3, 2.3e-4, 2.3e-5 of it at
+    P = 0.02, 0.002, 0.0002); and its interpolation, at an approach of 0.2%, within 0.2%."""
+    from shellsim.verify.elastica import load_at, point_phase
+
+    excess = [point_phase(p)[0] / ((np.pi / 4 - 2 / np.pi) * 2 * p) - 1.0 for p in (1e-2, 1e-3, 1e-4)]
+    assert excess[0] > 0.0 and excess[1] == pytest.approx(excess[0] / 10, rel=0.05)
+    assert excess[2] == pytest.approx(excess[0] / 100, rel=0.05)
+    assert 2e-3 / ((np.pi / 4 - 2 / np.pi) * load_at(2e-3, 1.0, 1.0)) == pytest.approx(1.0, abs=2e-3)
+
+
 def test_a_ring_crushed_to_half_its_diameter_follows_the_elastica_through_its_flat_phase():
     """The ring of the test above (16 quadratic elements over the quarter) crushed
     statically until the plates have approached by 52% of its diameter: past 28% the ring

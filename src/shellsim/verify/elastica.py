@@ -17,11 +17,10 @@ phase, c is found so that theta = pi at A (s = pi R / 2); the plates' approach i
 lies flat over a length a at each end of the quarter (curvature zero there, the load
 taken where it leaves the plate), and (c, a) are found so that theta = pi and
 theta' = 0 at s = pi R / 2 - a. This is the shooting method on the elastica's equations
-of Frisch-Fay, *Flexible Bars* (Butterworths, 1962, ch. 2), as used for the ring
-between plates by Wang, C.Y., and Watson, L.T., "The large deformation of a circular
-ring compressed between two flat plates", and in Timoshenko & Gere's *Theory of Elastic
-Stability* (2nd ed., 1961) for the small-deflection limit
-2 delta = 2 (pi/4 - 2/pi) P R^3 / EI, which :func:`load_at` reproduces as P -> 0.
+(Frisch-Fay, *Flexible Bars*, Butterworths, 1962); as the load goes to zero it gives
+the thin ring's linear answer, a change of the loaded diameter (pi/4 - 2/pi) P R^3 / EI
+(Timoshenko, *Strength of Materials* I, curved bars; Roark's Formulas, Table 9.2
+case 1).
 """
 
 from __future__ import annotations
@@ -49,8 +48,9 @@ def _ending_level(load: float, length: float) -> float:
     return brentq(lambda c: _arc(load, c, length)[0] - np.pi, -1.0, 50.0, xtol=1e-14)
 
 
-def _point_phase(load: float) -> tuple[float, float]:
-    """(approach / R, curvature at A times R) of the point phase under half-load p."""
+def point_phase(load: float) -> tuple[float, float]:
+    """(approach / R, curvature at A times R) of the point phase under the dimensionless
+    half-load p = P R^2 / (2 EI)."""
     quarter = np.pi / 2
     _, curvature, height = _arc(load, _ending_level(load, quarter), quarter)
     return 2.0 * (1.0 - height), curvature
@@ -70,7 +70,7 @@ def _flat_phase(load: float) -> float:
 
 def _flat_start_load() -> float:
     """The half-load p at which the curvature at A reaches zero."""
-    return brentq(lambda p: _point_phase(p)[1], 0.1, 50.0, xtol=1e-13)
+    return brentq(lambda p: point_phase(p)[1], 0.1, 50.0, xtol=1e-13)
 
 
 def load_path(points: int = 40, largest_approach: float = 1.1) -> tuple[np.ndarray, np.ndarray]:
@@ -81,7 +81,7 @@ def load_path(points: int = 40, largest_approach: float = 1.1) -> tuple[np.ndarr
     flat_start = _flat_start_load()
     approaches, loads = [0.0], [0.0]
     for p in np.linspace(0.0, flat_start, points + 1)[1:]:
-        approaches.append(_point_phase(p)[0])
+        approaches.append(point_phase(p)[0])
         loads.append(2.0 * p)
     p = flat_start
     while approaches[-1] < largest_approach:
@@ -102,4 +102,4 @@ def load_at(approach, radius: float, bending_stiffness: float, path=None):
 
 def flat_phase_start() -> float:
     """The approach / R at which the ring begins to lie flat along the plates."""
-    return _point_phase(_flat_start_load())[0]
+    return point_phase(_flat_start_load())[0]

@@ -176,7 +176,13 @@ against = "leaflet_{b}"
 """ for a, b in ((1, 2), (2, 3), (3, 1)))
 
 
-def test_the_valve_closes_under_diastolic_pressure_its_free_edges_meeting():
+@pytest.fixture(scope="module")
+def closed_by_pairs():
+    """(run, deck) of :func:`_closed` with a contact table per pair (:data:`CLOSING`)."""
+    return _closed(CLOSING)
+
+
+def test_the_valve_closes_under_diastolic_pressure_its_free_edges_meeting(closed_by_pairs):
     """The builder's valve (h = 0.5, the leaflets 0.55 apart, 72 elements), clamped along
     its attachments, closed statically by 80 mmHg (0.010666 MPa) on the aortic faces with
     contact between each pair of leaflets: the solve converges; every free-edge node off
@@ -186,12 +192,12 @@ def test_the_valve_closes_under_diastolic_pressure_its_free_edges_meeting():
     how far they sag: linear elastic E = 2 MPa here. Measured: 23 load steps, 136
     iterations; gaps -0.098 h (the middles, pressed by two neighbours) to -0.031 h; each
     pair's force 0.5895 N to 1e-10, its coaptation area 57.4 mm^2."""
-    run, deck = _closed(CLOSING)
+    run, deck = closed_by_pairs
     assert run.status == "completed" and len(run.newton) < 60
     _assert_shut_and_alike(run, deck)
 
 
-def test_one_self_contact_table_over_the_three_leaflets_closes_the_valve_as_the_pairs_do():
+def test_one_self_contact_table_over_the_three_leaflets_closes_the_valve_as_the_pairs_do(closed_by_pairs):
     """The same valve with one self-contact table over all three leaflets instead of a
     table per pair: each leaflet's nodes are tested against each leaflet's faces, so a
     middle node, where the three meet, pushes both neighbours' faces, as with a table per
@@ -203,7 +209,7 @@ def test_one_self_contact_table_over_the_three_leaflets_closes_the_valve_as_the_
     run, deck = _closed(single)
     assert run.status == "completed" and len(run.newton) < 60
     _assert_shut(run, deck)
-    pairs, _ = _closed(CLOSING)
+    pairs, _ = closed_by_pairs
     total = sum(pairs.history[f"leaflets_{pair}"][-1] for pair in ("12", "23", "31"))
     assert run.history["leaflets"][-1] == pytest.approx(total, rel=1e-6)
     np.testing.assert_allclose(run.sim.state.x, pairs.sim.state.x, rtol=0.0, atol=1e-6 * RC)

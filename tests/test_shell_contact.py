@@ -292,28 +292,42 @@ def test_the_faces_keep_their_initial_thickness_as_the_shell_thins(tmp_path):
     np.testing.assert_allclose(ToolForces(model, []).gaps(0.0, thinned), 0.003, rtol=0, atol=1e-12)
 
 
-def test_the_contact_forces_are_the_derivative_of_the_energy_the_springs_hold(tmp_path):
-    """Two plates built touching, then the upper one moved 0.002 into the lower: the
-    energy the contact's springs hold (history column between_energy), differenced over
-    a move of the upper plate along z, is less the contact force on it, both passes and
-    the faces' shares counted (a conservative contact: its stored energy is what its
-    forces did). Within the smoothing width too (a move of 5e-6)."""
-    from shellsim.bundles import Shape
+def touching_plates(tmp_path):
+    """(model, the upper plate's nodes, its contact's ToolForces) of two plates built
+    touching (4 x 4 under 3 x 3), a contact 'between' them, the springs set to 1 per unit
+    mass at dt = 1."""
     from shellsim.loads import calibrate
     from shellsim.model import build_model
 
     text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3).as_posix()}"',
                      '[[contact]]\ntype = "shells"\nname = "between"\nset = "upper"\nagainst = "lower"\n')
     deck = parse_deck(text)
-    model = build_model(deck, build_mesh(deck))
+    mesh = build_mesh(deck)
+    model = build_model(deck, mesh)
     calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
-    upper = build_mesh(deck).sets["upper"].nodes
-    measures = ToolForces(model, ["between"])
+    return model, mesh.sets["upper"].nodes, ToolForces(model, ["between"])
 
-    def moved(down: float) -> Shape:
-        x = model.x0.copy()
-        x[upper, 2] -= down
-        return Shape(x=x, d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+
+def upper_moved(model, upper, down: float, slide: float = 0.0):
+    """The initial shape with the ``upper`` nodes moved ``down`` along -z and ``slide`` along x."""
+    from shellsim.bundles import Shape
+
+    x = model.x0.copy()
+    x[upper, 2] -= down
+    x[upper, 0] += slide
+    return Shape(x=x, d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy())
+
+
+def test_the_contact_forces_are_the_derivative_of_the_energy_the_springs_hold(tmp_path):
+    """Two plates built touching, then the upper one moved 0.002 into the lower: the
+    energy the contact's springs hold (history column between_energy), differenced over
+    a move of the upper plate along z, is less the contact force on it, both passes and
+    the faces' shares counted (a conservative contact: its stored energy is what its
+    forces did). Within the smoothing width too (a move of 5e-6)."""
+    model, upper, measures = touching_plates(tmp_path)
+
+    def moved(down: float):
+        return upper_moved(model, upper, down)
 
     for down in (0.002, 5e-6):
         step = 1e-8
@@ -328,23 +342,12 @@ def test_held_pairs_keep_each_node_on_its_face_until_released(tmp_path):
     iterations hold them), then the upper plate slid 0.3 along x, past a lower element:
     each contact node keeps the face it touched, and those no longer over it push no
     more; released, the faces are searched again and every upper node pushes."""
-    from shellsim.bundles import Shape
-    from shellsim.loads import calibrate, contact_pairs, hold_pairs, pairs_added
-    from shellsim.model import build_model
+    from shellsim.loads import contact_pairs, hold_pairs, pairs_added
 
-    text = deck_text(f'builder = "file"\npath = "{stacked_plates(tmp_path / "plates.vtu", 4, 3).as_posix()}"',
-                     '[[contact]]\ntype = "shells"\nname = "between"\nset = "upper"\nagainst = "lower"\n')
-    deck = parse_deck(text)
-    model = build_model(deck, build_mesh(deck))
-    calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
-    upper = build_mesh(deck).sets["upper"].nodes
-    measures = ToolForces(model, ["between"])
+    model, upper, measures = touching_plates(tmp_path)
 
     def pushing(slide: float) -> int:
-        x = model.x0.copy()
-        x[upper, 2] -= 0.002
-        x[upper, 0] += slide
-        forces = measures.at_nodes(0.0, Shape(x=x, d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy()))
+        forces = measures.at_nodes(0.0, upper_moved(model, upper, 0.002, slide))
         return int(np.count_nonzero(np.linalg.norm(forces[upper], axis=1)))
 
     assert pushing(0.0) == len(upper)

@@ -93,6 +93,11 @@ class RigidTool(ContactTable):
         return self
 
     @property
+    def moving_curve(self) -> str | None:
+        """The curve of the tool's motion where it moves on one."""
+        return self.curve if any(self.motion) else None
+
+    @property
     def summary(self) -> str:
         """One line for ``shellsim check``: the tool, its motion, the faces and the cost."""
         where = {"plane": f"through {list(self.point)} facing {list(self.normal or ())}",

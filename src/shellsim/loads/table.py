@@ -68,6 +68,12 @@ class ContactTable(LoadTable):
         return friction
 
     @property
+    def moving_curve(self) -> str | None:
+        """The curve that moves what the contact's surface meets (a tool pushed on), None
+        where nothing moves: kinetic damping waits for it to stop."""
+        return None
+
+    @property
     def friction_summary(self) -> str:
         """The friction for ``check``'s line: '' when frictionless."""
         return f", friction {self.friction:g}" if self.friction else ""

@@ -19,7 +19,7 @@ from .output_fields import FIELD_KINDS, WRITTEN_AS, field_problems
 from .geometry import BUILDERS, Geometry, division_problems, proportion_problems
 from .material import MATERIALS, Material
 from ..materials.axes import CentrelineAxes, CylindricalAxes
-from ..loads import CABLE_TABLES, CONTACT_TABLES
+from ..loads import CABLE_TABLES, CONTACT_TABLES, friction_in_newton
 from ..loads import TABLES as LOAD_TABLES
 from ..measures import OUTPUT_FIELDS
 from ..table_types import Count, Line, Name, NonNegative, Positive, Real, Section, Text, Vec3
@@ -654,9 +654,9 @@ class Deck(Section):
                          "solve has none (it is frictionless); give friction = 0, or solver.method = 'explicit'"
                          for i, c in enumerate(self.contact) if c.friction]
         if self.solver.method == "implicit":
-            problems += [f"contact[{i}].friction = {c.friction:g}: the implicit solve takes contact without "
-                         "friction (its sliding impulses are the explicit loop's); give friction = 0, or "
-                         "solver.method = 'explicit'" for i, c in enumerate(self.contact) if c.friction]
+            problems += [f"contact[{i}].friction = {c.friction:g}: the implicit solve takes friction between shells "
+                         f"(type = 'shells'), not on a {c.type!r} contact; give friction = 0, or solver.method = "
+                         "'explicit'" for i, c in enumerate(self.contact) if c.friction and not friction_in_newton(c)]
         if self.solver.ramp_end is not None:  # a static solve, or a static preload
             problems += [f"cable[{i}].segments = {c.segments}: a chord's interior nodes have no stiffness while it "
                          "is slack, so a static solve cannot find them; give segments = 1, or an explicit run "

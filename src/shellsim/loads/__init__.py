@@ -393,6 +393,12 @@ def friction_forces(t, model, shape, v, w, f_fr, fr_fr, g):
     to_rotational(g, shape.d, shape.e1, fr_fr)
 
 
+def friction_in_newton(table) -> bool:
+    """Whether the kind of the contact ``table`` has its friction's derivative
+    (``friction_couplings``), which an implicit step's Newton iterations need."""
+    return hasattr(_KIND_OF[type(table)], "friction_couplings")
+
+
 def has_friction(model) -> bool:
     """Whether any contact of ``model`` has friction (a ``friction`` field not all zero)."""
     return any(np.any(bundle.friction) for _, bundle in _with(model, "add_friction"))
@@ -407,20 +413,28 @@ class LoadTangents:
         self.model = model
         self._calls = [(TypedCall(kind.add_tangent), bundle) for kind, bundle in _with(model, "add_tangent")]
         self._couplings = [(TypedCall(kind.couplings), bundle) for kind, bundle in _with(model, "couplings")]
+        self._friction = [(TypedCall(kind.friction_couplings), bundle)
+                          for kind, bundle in _with(model, "friction_couplings") if np.any(bundle.friction)]
 
     def __call__(self, t: float, shape: Shape, step_u: float, step_r: float, k: np.ndarray) -> None:
         for add_tangent, bundle in self._calls:
             add_tangent(float(t), self.model, shape, bundle, step_u, step_r, k)
 
-    def couplings(self, t: float, shape: Shape, step_u: float) -> tuple[np.ndarray, np.ndarray]:
+    def couplings(self, t: float, shape: Shape, step_u: float,
+                  motion: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The derivative of the forces that couple nodes sharing no element: nodes (P, 10)
         and blocks (P, 30, 30) d(force)/d(translation) of each group of ten nodes, global
-        axes (translations of step ``step_u`` differenced)."""
+        axes (translations of step ``step_u`` differenced). With ``motion`` (v, rate), the
+        nodes moving at v (n, 3) whose derivative by the translations is ``rate``: the
+        contacts' friction's too."""
         nodes, blocks = [np.zeros((0, 10), dtype=np.int64)], [np.zeros((0, 30, 30))]
-        for couplings, bundle in self._couplings:
+        calls = [(call, bundle, ()) for call, bundle in self._couplings]
+        if motion is not None:
+            calls += [(call, bundle, ((motion[0], float(motion[1])),)) for call, bundle in self._friction]
+        for couplings, bundle, velocities in calls:
             n = len(bundle.nodes)
             some, their = np.zeros((n, 10), dtype=np.int64), np.zeros((n, 30, 30))
-            count = couplings(float(t), self.model, shape, bundle, step_u, some, their)
+            count = couplings(float(t), self.model, shape, bundle, *velocities, step_u, some, their)
             nodes.append(some[:count])
             blocks.append(their[:count])
         return np.concatenate(nodes), np.concatenate(blocks)

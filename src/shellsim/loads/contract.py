@@ -20,8 +20,8 @@ ROLES = {
     "load": ((), ("Bundle", "add_forces", "empty", "add_tangent", "couplings")),
     "contact": ((*CARRYING, "calibrate", "step_share", "item_forces", "item_energies", "item_gaps", "FORCE_TOTAL",
                  "SIDES"),
-                ("add_tangent", "add_friction", "deepest", "farthest_moved", "couplings", "empty", "overlaps_at_rest",
-                 "hold_pairs", "pairs")),
+                ("add_tangent", "add_friction", "friction_couplings", "deepest", "farthest_moved", "couplings", "empty",
+                 "overlaps_at_rest", "hold_pairs", "pairs")),
     "cable": ((*CARRYING, "extend_mesh", "add_masses", "critical_step"), ("add_tangent", "couplings", "empty")),
 }
 #: Hooks that come together or not at all.
@@ -69,4 +69,7 @@ def check_kind(kind: ModuleType) -> str:
         if getattr(table, "FRICTION", False) and not hasattr(kind, "add_friction"):
             raise TypeError(f"{where}: its table {table.__name__} takes a friction, which the kind has no add_friction "
                             "for: give the table FRICTION = False, so a friction given is refused")
+        if hasattr(kind, "friction_couplings") and not hasattr(kind, "add_friction"):
+            raise TypeError(f"{where} has friction_couplings without add_friction: the derivative of a friction "
+                            "it does not apply")
     return role

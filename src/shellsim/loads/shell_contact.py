@@ -469,43 +469,54 @@ def add_forces(t, model, shape, loads, f, g):
 def add_friction(t, model, shape, loads, f, g, v, w):
     """f (n, 3) += the friction of the contacts :func:`add_forces` found on this ``shape``
     (it reads what that left in loads.touches and loads.touch_forces), the nodes moving
-    at v (n, 3): against the contact node's velocity relative to the face point (N_a
-    v_a), tangent to the face, the smaller of mu times the push and the stick damper
-    times that velocity (the relative motion's mass over the critical step, 1 / (dt_c
-    (1/m_y + sum_a N_a^2 / m_a)): it stops the slip within a critical step, as sticking
-    does), on the node and back on the face's nodes by N_a. w (n, 2) unread: the forces
-    act at the mid-surface."""
-    slip, shares = np.empty(3), np.empty(9)
+    at v (n, 3) (:func:`_pair_friction`). w (n, 2) unread: the forces act at the
+    mid-surface."""
+    out, scratch = np.empty((10, 3)), (np.empty(3), np.empty(9))
     for m in range(loads.nodes.shape[0]):
         row = loads.touches[m]
         if row < 0 or loads.friction[m] == 0.0:
             continue
-        pushed = loads.touch_forces[m]
-        push = np.sqrt(pushed[0, 0] ** 2 + pushed[0, 1] ** 2 + pushed[0, 2] ** 2)
-        if push == 0.0:
-            continue
-        node = loads.nodes[m]
-        copy_into(v[node], slip)
-        weight = loads.inverse_mass[m]
-        for a in range(9):  # N_a from the face's share of the push
-            shares[a] = -(pushed[1 + a, 0] * pushed[0, 0] + pushed[1 + a, 1] * pushed[0, 1]
-                          + pushed[1 + a, 2] * pushed[0, 2]) / (push * push)
-            weight += shares[a] * shares[a] * loads.face_inverse_mass[row, a]
-            for i in range(3):
-                slip[i] -= shares[a] * v[loads.faces[row, a], i]
-        along = (slip[0] * pushed[0, 0] + slip[1] * pushed[0, 1] + slip[2] * pushed[0, 2]) / push
+        _pair_friction(loads.touch_forces[m], v, loads, m, row, out, scratch)
         for i in range(3):
-            slip[i] -= along * pushed[0, i] / push
-        speed = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
-        if speed == 0.0:
-            continue
-        critical = np.sqrt(loads.penalty[m] / loads.spring[m])
-        drag = min(loads.friction[m] * push, speed / (critical * weight)) / speed
+            f[loads.nodes[m], i] += out[0, i]
+            for a in range(9):
+                f[loads.faces[row, a], i] += out[1 + a, i]
+
+
+@njit(cache=True)
+def _pair_friction(pushed, v, loads, m, row, out, scratch):
+    """out (10, 3): the friction on contact node m and the nine nodes of face ``row``
+    pushed by ``pushed`` (10, 3) (:func:`_pair_forces`), the nodes moving at v (n, 3):
+    against the node's velocity relative to the face point (N_a v_a), tangent to the
+    face, the smaller of mu times the push and the stick damper times that velocity (the
+    relative motion's mass over the critical step, 1 / (dt_c (1/m_y + sum_a N_a^2 /
+    m_a)): it stops the slip within a critical step, as sticking does), on the node and
+    back on the face's nodes by N_a. scratch: (3,) and (9,) arrays."""
+    slip, shares = scratch
+    out[:] = 0.0
+    push = np.sqrt(pushed[0, 0] ** 2 + pushed[0, 1] ** 2 + pushed[0, 2] ** 2)
+    if push == 0.0:
+        return
+    copy_into(v[loads.nodes[m]], slip)
+    weight = loads.inverse_mass[m]
+    for a in range(9):  # N_a from the face's share of the push
+        shares[a] = -(pushed[1 + a, 0] * pushed[0, 0] + pushed[1 + a, 1] * pushed[0, 1]
+                      + pushed[1 + a, 2] * pushed[0, 2]) / (push * push)
+        weight += shares[a] * shares[a] * loads.face_inverse_mass[row, a]
         for i in range(3):
-            f[node, i] -= drag * slip[i]
+            slip[i] -= shares[a] * v[loads.faces[row, a], i]
+    along = (slip[0] * pushed[0, 0] + slip[1] * pushed[0, 1] + slip[2] * pushed[0, 2]) / push
+    for i in range(3):
+        slip[i] -= along * pushed[0, i] / push
+    speed = np.sqrt(slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2])
+    if speed == 0.0:
+        return
+    critical = np.sqrt(loads.penalty[m] / loads.spring[m])
+    drag = min(loads.friction[m] * push, speed / (critical * weight)) / speed
+    for i in range(3):
+        out[0, i] = -drag * slip[i]
         for a in range(9):
-            for i in range(3):
-                f[loads.faces[row, a], i] += shares[a] * drag * slip[i]
+            out[1 + a, i] = shares[a] * drag * slip[i]
 
 
 @njit(cache=True)
@@ -644,6 +655,46 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
             x[node, i] = kept - step_u
             _pair_forces(x, shape.h, loads, m, row, minus, work)
             x[node, i] = kept
+            for a in range(10):
+                for k in range(3):
+                    blocks[count, 3 * a + k, j] = (plus[a, k] - minus[a, k]) / (2.0 * step_u)
+        count += 1
+    return count
+
+
+@njit(cache=True)
+def friction_couplings(t, model, shape, loads, motion, step_u, nodes, blocks):
+    """The derivative of each touching pair's friction with respect to its ten nodes'
+    translations, ``motion`` (v, rate): the nodes moving at v (n, 3) whose derivative by
+    the translations is ``rate`` (an implicit step's gamma / (beta dt)): central differences of step
+    ``step_u`` moving a node by it and its velocity by ``rate`` times it, the pair and the
+    fibre lengths held. nodes (K, 10), blocks (K, 30, 30) dF/dx as :func:`couplings`'s;
+    returns how many pairs with friction touch (or are held)."""
+    shape = _at_initial_thickness(model, shape)
+    grid = _grid(shape, loads, 1.0)
+    work = _work()
+    pushed, plus, minus = np.empty((10, 3)), np.empty((10, 3)), np.empty((10, 3))
+    scratch = (np.empty(3), np.empty(9))
+    x, (v, rate) = shape.x, motion
+    count = 0
+    for m in range(loads.nodes.shape[0]):
+        if loads.friction[m] == 0.0:
+            continue
+        row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
+        if row < 0:
+            continue
+        nodes[count, 0] = loads.nodes[m]
+        copy_into(loads.faces[row], nodes[count, 1:])
+        for j in range(30):
+            node, i = nodes[count, j // 3], j % 3
+            kept, kept_v = x[node, i], v[node, i]
+            for side in range(2):
+                sign, out = (1.0, plus) if side == 0 else (-1.0, minus)
+                x[node, i] = kept + sign * step_u
+                v[node, i] = kept_v + sign * rate * step_u
+                _pair_forces(x, shape.h, loads, m, row, pushed, work)
+                _pair_friction(pushed, v, loads, m, row, out, scratch)
+            x[node, i], v[node, i] = kept, kept_v
             for a in range(10):
                 for k in range(3):
                     blocks[count, 3 * a + k, j] = (plus[a, k] - minus[a, k]) / (2.0 * step_u)

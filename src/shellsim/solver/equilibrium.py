@@ -95,6 +95,8 @@ class Equilibrium:
             np.subtract(s.d, c["d"], out=space.dd)
             s.stress[:] = c["stress"]
             s.h[:] = c["h"]
+        if self.inertia is not None:
+            self.inertia.move_velocities()  # the contacts' friction opposes them
         self.sim.compute_forces(t)
 
     def residual(self) -> np.ndarray:
@@ -166,9 +168,10 @@ class Equilibrium:
 
     def _coupled(self) -> sp.coo_matrix | None:
         """The derivative of the forces that couple nodes sharing no element (contact
-        between shells) over the unknowns, in the nodes' frames; None where there is none."""
+        between shells, and its friction in an implicit step) over the unknowns, in the nodes' frames; None where there is none."""
         u, s = self.unknowns, self.sim.state
-        nodes, blocks = self._load_tangents.couplings(self._t, s.fields.shape, self.step_u)
+        motion = None if self.inertia is None else (s.v, self.inertia.velocity_rate)
+        nodes, blocks = self._load_tangents.couplings(self._t, s.fields.shape, self.step_u, motion)
         if not len(nodes):
             return None
         frames = u.frames[nodes]  # (P, 10, 3, 3): node translations' directions as columns

@@ -12,7 +12,9 @@ Method, 9.3), c the deck's mass-proportional ``damping``. The translations u are
 nodes' positions; the rotations the fibre-frame angles the static solve accumulates
 (``theta``), with the rotary masses. The residual's derivative adds (1 / (beta dt^2) +
 (1 + alpha) c gamma / (beta dt)) M to (1 + alpha) times the static tangent: the masses
-keep every unknown stiff, a slack chord's node too.
+keep every unknown stiff, a slack chord's node too. Friction between shells opposes
+the iterate's velocities, v above, and its derivative by the translations, through v's
+gamma / (beta dt), joins the tangent (:func:`shellsim.loads.shell_contact.friction_couplings`).
 """
 
 from __future__ import annotations
@@ -63,6 +65,18 @@ class HHT:
         spin = (s.theta - n["theta"] - dt * n["w"] - dt * dt * (0.5 - beta) * n["alpha"]) / (beta * dt * dt)
         return (a, spin, n["v"] + dt * ((1.0 - gamma) * n["a"] + gamma * a),
                 n["w"] + dt * ((1.0 - gamma) * n["alpha"] + gamma * spin))
+
+    def move_velocities(self) -> None:
+        """Set the state's velocities to Newmark's at its shape (what the contacts' friction
+        opposes); none before the step's end time is set."""
+        if self.dt > 0.0:
+            s = self.sim.state
+            _, _, s.v[:], s.w[:] = self._motion()
+
+    @property
+    def velocity_rate(self) -> float:
+        """d v / d u of Newmark's velocities, gamma / (beta dt) [1/s]."""
+        return self.gamma / (self.beta * self.dt)
 
     def balanced(self, f: np.ndarray, fr: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The step's residual forces from the state's out-of-balance ones f = f_ext - f_int

@@ -1,5 +1,5 @@
 """The energies of a static solve: the internal work and the external work (the loads'
-and the supports' reactions on prescribed motion), summed by the trapezoidal rule between
+and the supports' reactions on prescribed motion; in an implicit one, friction's apart), summed by the trapezoidal rule between
 converged load steps, as the explicit loop sums them between time steps.
 
 At equilibrium the two differ only by the work of the residual the steps converged to,
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from .equilibrium import Equilibrium
-from .explicit import EXTERNAL, INTERNAL
+from .explicit import EXTERNAL, FRICTION, INTERNAL
 
 
 class StaticWork:
@@ -27,9 +27,10 @@ class StaticWork:
     def _now(self) -> dict[str, np.ndarray]:
         """The converged state's positions, rotations and forces, and the supports'
         reactions along the prescribed axes (n_known,)."""
-        s, n_free = self.eq.sim.state, self.eq.unknowns.n_free
+        s, n_free, space = self.eq.sim.state, self.eq.unknowns.n_free, self.eq.sim.workspace
         return {"x": s.x.copy(), "theta": s.theta.copy(), "f_int": s.f_int.copy(), "fr_int": s.fr_int.copy(),
-                "f_ext": s.f_ext.copy(), "fr_ext": s.fr_ext.copy(), "reaction": -self.eq.residual()[n_free:]}
+                "f_ext": s.f_ext.copy(), "fr_ext": s.fr_ext.copy(), "reaction": -self.eq.residual()[n_free:],
+                "f_fr": space.f_fr.copy(), "fr_fr": space.fr_fr.copy()}
 
     def add_step(self) -> None:
         """Add the works from the last converged state to the state now (converged, its
@@ -43,7 +44,10 @@ class StaticWork:
         p = self.eq.sim.model.constraints.prescribed
         reactions = 0.5 * float(np.sum((before["reaction"] + now["reaction"]) * dx[p.nodes, p.axes]))
         s = self.eq.sim.state
+        friction = work("f_fr", "fr_fr") if self.eq.sim.workspace.friction else 0.0
         s.work[INTERNAL] += work("f_int", "fr_int")
-        s.work[EXTERNAL] += work("f_ext", "fr_ext") + reactions
-        s.energy[INTERNAL], s.energy[EXTERNAL] = s.work[INTERNAL], s.work[EXTERNAL]
+        s.work[EXTERNAL] += work("f_ext", "fr_ext") + reactions - friction  # friction is among f_ext
+        s.work[FRICTION] -= friction
+        for kind in (INTERNAL, EXTERNAL, FRICTION):
+            s.energy[kind] = s.work[kind]
         self._last = now

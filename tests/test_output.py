@@ -725,3 +725,14 @@ def test_a_run_cut_short_judges_only_the_values_it_reached(tmp_path):
         times = np.asarray(run.times)
         _draw_references(ax, run.deck, "tip", times, times, 1.0, 1.0, whole)
         assert sorted(label.split("(")[1].split(")")[0] for label in ax.get_legend_handles_labels()[1]) == drawn
+
+
+def test_values_beyond_single_precision_are_written_as_infinities_without_a_warning():
+    """The last frame of a run that blew up holds values past float32's range: they are
+    stored as +-inf, and nothing is printed over the run's own error message."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        stored = Encoding(np.float32).floats(np.array([1e300, -1e300, 1.5]))
+    np.testing.assert_array_equal(stored, np.array([np.inf, -np.inf, 1.5], dtype=np.float32))

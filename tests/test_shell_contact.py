@@ -261,6 +261,8 @@ def test_check_names_each_shell_contact_with_its_cost(tmp_path):
     assert checked.exit_code == 0, checked.output
     assert "'fold': shell faces of 'all' against itself, both ways, 1 x the half thicknesses apart" in said
     assert "penalty 0.2, the critical step x 0.953 (" in said
+    # the forecast counts the contact's forces, timed on the model at rest
+    assert re.search(r"per unit of simulated time; contact \d+% of each step at rest, more as it spreads", said), said
 
 
 @pytest.mark.parametrize(("lift", "expected"), [(0.003, 0.003), (0.05, np.nan)])

@@ -631,9 +631,11 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                    + f": about {outlook['steps']:,} steps to the end at that "
                                    "step (it falls as elements crumple or stiffen, and the steps and cost grow "
                                    "with it; the run's progress shows the step as it goes)")
+        contact = (f"; contact {100 * outlook['contact_share']:.0f}% of each step at rest, more as it spreads"
+                   if outlook["contact_share"] else "")
         row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "
-                              f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time), "
-                              f"{size_text(outlook['bytes'])} of memory")
+                    f"({duration(outlook['seconds'] / sv.end_time)} per unit of simulated time{contact}), "
+                    f"{size_text(outlook['bytes'])} of memory")
     for ref in scene.reference:
         tolerance = f"{ref.tolerance_percent}%" if ref.tolerance is None else f"{ref.tolerance}"
         row("reference", f"{ref.quantity}: {ref.expected} ± {tolerance} "

@@ -31,7 +31,8 @@ and, when it has kernels of its own,
   both sides of a contact between shells, whose nodes' areas count each contact twice);
   compiled ``item_gaps(t, model, shape, bundle, out)``, each contact node's gap (the
   clearance between its face and what it may touch; +inf beyond the search's reach),
-  and ``item_energies(t, model, shape, bundle, out)``, the energy in its springs;
+  and ``item_energies(t, model, shape, bundle, out)``, the energy in its springs (after
+  ``item_forces`` on the same shape: it may read what that left in the bundle);
 - where it has friction: compiled ``add_friction(t, model, shape, bundle, f, g, v, w)``,
   its sliding forces at the velocities v (n, 3), w (n, 2), added after its
   ``add_forces`` on the same shape (it may read what that left in the bundle);
@@ -279,6 +280,11 @@ class ToolForces:
             np.add.at(energies, bundle.tool, stored)
         forces[resultant] = np.linalg.norm(totals[resultant], axis=1)
         return dict(zip(measure_names(self.names), np.column_stack([forces, areas, energies]).ravel().tolist()))
+
+    @property
+    def has_contact(self) -> bool:
+        """Whether the model has a contact table."""
+        return bool(self._forces)
 
     def seconds_per_evaluation(self, t: float, shape: Shape, repeats: int = 5) -> float:
         """The median wall time [s] of every contact kind's forces at time t on ``shape``

@@ -549,11 +549,12 @@ def deepest(t, model, shape, loads):
 @njit(cache=True)
 def item_energies(t, model, shape, loads, out):
     """out (K,): the energy stored in each contact node's spring on the current shape, its
-    push integrated over the depth (:func:`shellsim.loads.penalty_law.stored`)."""
+    push integrated over the depth (:func:`shellsim.loads.penalty_law.stored`), of the
+    pairs :func:`item_forces` found on this shape (it reads loads.touches: a search
+    again doubled the cost of a history sample)."""
     shape = _at_initial_thickness(model, shape)
     if loads.nodes.shape[0] == 0:
         return
-    _contact_forces(model, shape, loads)
     work = _work()
     for m in range(loads.nodes.shape[0]):
         out[m] = 0.0

@@ -27,8 +27,10 @@ class Encoding:
         return cls(np.float32 if output.precision == "single" else np.float64, output.compress)
 
     def floats(self, values: np.ndarray) -> np.ndarray:
-        """``values`` as contiguous floats of the stored precision."""
-        return np.ascontiguousarray(values, dtype=self.float_type)
+        """``values`` as contiguous floats of the stored precision: beyond float32's range,
+        +-inf (the last frame of a run that blew up is written as it is, without a warning)."""
+        with np.errstate(over="ignore"):
+            return np.ascontiguousarray(values, dtype=self.float_type)
 
 
 def symmetric_columns(tensors: np.ndarray) -> np.ndarray:

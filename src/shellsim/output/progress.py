@@ -82,12 +82,13 @@ class ProgressDisplay(Listener):
         self.stepping_since = (time.perf_counter(), run.sim.state.steps)  # not the compiling before
         if self.quiet:
             return
-        from ..solver.outlook import duration, stepping
+        from ..solver.outlook import contact_seconds, duration, stepping
 
-        steps, cost = stepping(run.deck.solver.end_time, run.dt, run.model.n_elements)
+        contact = contact_seconds(run.model, run.load_time, run.sim.state.fields.shape)
+        steps, cost = stepping(run.deck.solver.end_time, run.dt, run.model.n_elements, contact)
         self.announce(f"critical step {run.dt_critical:.4g}, step {run.dt:.4g}: about {steps:,.0f} steps, "
                       f"about {duration(cost)} of stepping ({duration(cost / run.deck.solver.end_time)} "
-                      "per unit of simulated time)")
+                      "per unit of simulated time" + (", contact's included" if contact else "") + ")")
 
     def _fields(self, run: Run) -> dict:
         if _static(run):  # its last load step in place of the time step

@@ -212,7 +212,9 @@ def test_a_strip_folded_onto_itself_by_pressure_rests_on_itself_one_thickness_aw
     the end slides over the face, its residual stuck near 1e-4 of the force scale), it
     rests on the strip's face: the centre line never crosses itself, no point nearer than
     0.9 h to a part of the strip more than 3 away along it (the penalty gives a little
-    under the fold's push), the fold pressing. Measured: free, the centre lines 0.46 h
+    under the fold's push), the fold pressing; the contact takes the shell's whole
+    thickness (``own_surface_limit = 0``: with the default single-surface limit, 0.4 of
+    the node spacing, the strip rests at 0.31 h). Measured: free, the centre lines 0.46 h
     apart; with contact, nearest 0.970 h, at rest (kinetic energy 1e-4 of the internal)."""
     h = 0.3
     text = (ROLLED.read_text().split("[[reference]]")[0]
@@ -224,7 +226,9 @@ def test_a_strip_folded_onto_itself_by_pressure_rests_on_itself_one_thickness_aw
         text = (text.replace("density = 1.510e-4", "density = 1.51")
                 .replace('method = "static"\nend_time = 4.0\nstatic = { increments = 10 }', "end_time = 3.0\ndamping = 10.0")
                 .replace("t = [0.0, 4.0]\nvalue = [0.0, 1.0]", 't = [0.0, 1.8]\nvalue = [0.0, 1.0]\ninterpolate = "smooth"'))
-        text += '\n[[contact]]\ntype = "shells"\nname = "fold"\n'
+        # the shell's whole thickness: its nodes are 0.4 apart, so the single-surface limit
+        # (0.4 of that, 0.16) would let the turns come within about half of h
+        text += '\n[[contact]]\ntype = "shells"\nname = "fold"\nown_surface_limit = 0.0\n'
     run = run_deck(parse_deck(text.replace("static = { increments = 10 }", "static = { increments = 40 }")))
     assert run.status == "completed"
     x0, x = run.model.x0, run.sim.state.x
@@ -479,3 +483,37 @@ def test_check_reports_shells_that_overlap_at_rest_with_how_many_how_deep_and_wh
     assert result.exit_code == 0, result.output
     assert re.search(r"contact 'between': 130 node\(s\) overlap faces of the other side at rest, by up to 0\.002 "
                      r"\(node \d+ at [-\d., e]+\): the faces a node overlaps at rest are never pushed against", said), said
+
+
+def test_the_spacing_of_a_nine_node_quads_nodes_is_the_shorter_of_its_grid_lines():
+    """A 4 x 6 element (nodes 2 and 3 apart along r and s): every node's spacing is 2."""
+    from shellsim.loads.shell_contact import node_spacing
+
+    x = np.column_stack([2.0 * NODE_RS[:, 0], 3.0 * NODE_RS[:, 1], np.zeros(9)])
+    np.testing.assert_array_equal(node_spacing(x, np.arange(9)[None]), np.full(9, 2.0))
+
+
+@pytest.mark.parametrize("limit", [0.0, 0.4])
+def test_a_surface_finer_than_it_is_thick_does_not_touch_itself_at_rest(limit):
+    """A flat strip of elements 0.1 long (nodes 0.05 apart) and 0.06 thick in self-contact:
+    with its contact thickness the shell's, every node lies within the reach (0.06) of
+    the faces next to those that hold it, overlapping them at rest; limited to 0.4 of the
+    node spacing (LS-DYNA's single-surface rule), the reach is 0.02 and no node overlaps
+    a face, each offset scaled by 0.4 x 0.05 / 0.06."""
+    from shellsim.model import build_model
+
+    text = deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 0.2', f'''
+[mesh]
+divisions = {{ length = 10, width = 2 }}
+[[contact]]
+type = "shells"
+name = "strip"
+own_surface_limit = {limit}
+''').replace("thickness = 0.01", "thickness = 0.06")
+    deck = parse_deck(text)
+    contact = build_model(deck, build_mesh(deck)).loads.shell_contact
+    if limit:
+        assert not np.any(contact.initial_depth > 0.0)
+        np.testing.assert_allclose(contact.offset, 0.4 * 0.05 / 0.06, rtol=1e-9)
+    else:
+        assert np.count_nonzero(contact.initial_depth > 0.0) > len(contact.nodes) / 2

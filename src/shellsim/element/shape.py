@@ -26,6 +26,10 @@ NODE_RS = np.array(
     [[1, 1], [-1, 1], [-1, -1], [1, -1], [0, 1], [-1, 0], [0, -1], [1, 0], [0, 0]], dtype=float
 )
 
+#: Node indices as the nodes lie: rows from s = +1 down to s = -1, columns from r = -1 to
+#: +1 (the grid lines neighbouring nodes share). Shape (3, 3).
+GRID = np.array([[1, 4, 0], [5, 8, 7], [2, 6, 3]])
+
 #: Node indices of the three nodes of each element edge, in the order
 #: (corner, mid-side, corner), walking the boundary counter-clockwise in (r, s).
 EDGES = np.array([[0, 4, 1], [1, 5, 2], [2, 6, 3], [3, 7, 0]])

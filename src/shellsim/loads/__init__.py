@@ -192,6 +192,15 @@ def pairs_added(model, before: list[np.ndarray]) -> int:
     return sum(int(np.count_nonzero((now >= 0) & (then < 0))) for now, then in zip(contact_pairs(model), before))
 
 
+def contact_of_node(model, node: int) -> str:
+    """', touching a face (of a contact between shells)' where ``node`` touched a face at
+    the last evaluation, else ''."""
+    for pairs_now, (_, bundle) in zip(contact_pairs(model), _with(model, "pairs")):
+        if np.any(pairs_now[bundle.nodes == node] >= 0):
+            return ", touching a face (a contact between shells)"
+    return ""
+
+
 def needs_calibration(model) -> bool:
     """Whether some kind of ``model`` has penalty springs for :func:`calibrate` to set."""
     return bool(_with(model, "calibrate"))

@@ -42,8 +42,9 @@ from scipy.sparse.csgraph import connected_components
 
 from ..array_copy import copy_into
 from ..bundles import Shape
+from ..element.shape import GRID
 from ..errors import MeshError
-from ..table_types import Name, Positive
+from ..table_types import Name, NonNegative, Positive
 from . import penalty_law
 from .penalty_law import TOUCHING
 from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
@@ -55,13 +56,17 @@ class ShellContact(ContactTable):
     leaflet), or with its own (no ``against``: self-contact, a strip rolling over itself).
     ``offset``: the share of the half thicknesses kept between mid-surfaces (1: the faces
     touch). ``penalty``: the soft constraint's scale s (the critical step falls by the
-    factor 1 / sqrt(1 + s / 2)). ``friction``: Coulomb's mu between the faces. ``name``:
-    the history column of the contact force (the sum of the contact forces' magnitudes,
-    both ways)."""
+    factor 1 / sqrt(1 + s / 2)). ``friction``: Coulomb's mu between the faces.
+    ``own_surface_limit``: where a surface meets itself (self-contact), a node's contact
+    thickness is at most this share of the shortest spacing of the nodes around it, as
+    LS-DYNA limits a single-surface contact's to 40% of the shortest edge (SSTHK = 0); 0:
+    the shell's thickness (SSTHK = 1). ``name``: the history column of the contact force
+    (the sum of the contact forces' magnitudes, both ways)."""
 
     type: Literal["shells"]
     against: Name | None = None
     offset: Positive = 1.0
+    own_surface_limit: NonNegative = 0.4
 
     @property
     def named_sets(self) -> dict[str, str]:
@@ -72,9 +77,11 @@ class ShellContact(ContactTable):
     def summary(self) -> str:
         """One line for ``shellsim check``."""
         other = f"'{self.against}'" if self.against else "itself"
+        limit = (f" (against its own surface at most {self.own_surface_limit:g} x the node spacing)"
+                 if self.against is None and self.own_surface_limit else "")
         return (f"'{self.name}': shell faces of '{self.set}' against {other}, both ways, {self.offset:g} x the half "
-                f"thicknesses apart; penalty {self.penalty:g}, the critical step x {share_of(self.penalty):.3f}"
-                f"{self.friction_summary}")
+                f"thicknesses apart{limit}; penalty {self.penalty:g}, the critical step x "
+                f"{share_of(self.penalty):.3f}{self.friction_summary}")
 
 
 TABLES = (ShellContact,)
@@ -155,15 +162,47 @@ def build(table: ShellContact, scene) -> Bundle:
         if not 1 < len(surfaces) <= MOST_SURFACES:
             surfaces = [mine.elements]
         passes = [(np.unique(scene.mesh.conn[nodes_of]), faces_of) for nodes_of in surfaces for faces_of in surfaces]
+        own = [i == j for i in range(len(surfaces)) for j in range(len(surfaces))]
     else:
         theirs = sets[table.against]
         passes = [(mine.nodes, theirs.elements), (theirs.nodes, mine.elements)]
+        own = [False, False]
     loads = _passes(passes, scene.mesh.conn, place=scene.place, table=table)
+    if table.own_surface_limit:
+        on_own = np.concatenate([np.full(len(nodes), mine_too) for (nodes, _), mine_too in zip(passes, own)])
+        _limit_own_surface(loads, on_own, table.own_surface_limit, scene)
     crowded = _initial_overlaps(scene.initial, loads)
     if crowded >= 0:
         raise MeshError(f"node {loads.nodes[crowded]} overlaps more than {IGNORED} faces in the initial shape: the "
                         "shell is much thicker than its elements there; give a smaller offset or a coarser mesh")
     return loads
+
+
+def _limit_own_surface(loads: Bundle, on_own: np.ndarray, limit: float, scene) -> None:
+    """Where a node meets its own surface (on_own (K,)), its offset scaled so that its
+    contact thickness is at most ``limit`` times the shortest spacing of the nodes around
+    it (in place). Otherwise a surface finer than it is thick touches itself: a node
+    finds the faces of its neighbours' neighbours within its reach as soon as the mesh
+    is squeezed along it (a tricuspid valve of 0.26 mm elements under 0.4 mm shells
+    closing: 3,400 nodes touching, one flung out at 3,800 mm/s, at 1% of the pressure)."""
+    spacing = node_spacing(scene.initial.x, scene.mesh.conn)
+    nodes = loads.nodes[on_own]
+    loads.offset[on_own] *= np.minimum(1.0, limit * spacing[nodes] / scene.initial.h[nodes])
+
+
+def node_spacing(x: np.ndarray, conn: np.ndarray) -> np.ndarray:
+    """(n,) each node's shortest distance to a node next to it along an element's grid
+    lines (the 3 x 3 nodes of a 9-node quad: 12 segments each), +inf off the elements.
+    x (n, 3) positions, conn (ne, 9)."""
+    grid = conn[:, GRID]  # (ne, 3, 3) the nodes as they lie
+    segments = np.concatenate([np.stack([grid[:, :, :-1], grid[:, :, 1:]], -1).reshape(len(conn), -1, 2),
+                               np.stack([grid[:, :-1, :], grid[:, 1:, :]], -1).reshape(len(conn), -1, 2)], axis=1)
+    ends = segments.reshape(-1, 2)
+    lengths = np.linalg.norm(x[ends[:, 0]] - x[ends[:, 1]], axis=1)
+    spacing = np.full(len(x), np.inf)
+    np.minimum.at(spacing, ends[:, 0], lengths)
+    np.minimum.at(spacing, ends[:, 1], lengths)
+    return spacing
 
 
 def _surfaces(elements: np.ndarray, conn: np.ndarray) -> list[np.ndarray]:

@@ -19,8 +19,8 @@ from functools import cached_property
 import numpy as np
 
 from ..deck import Deck
-from ..errors import NumericalError, OutputError, SceneTooLarge
-from ..loads import calibrate, needs_calibration, stable_step
+from ..errors import NumericalError, OutputError, SceneTooLarge, place
+from ..loads import calibrate, contact_of_node, needs_calibration, stable_step
 from ..mesh import Mesh
 from ..model import Model
 from ..measures import Measure, resolve_measures
@@ -324,7 +324,27 @@ def _breakdown_cause(run: Run) -> str:
                if ratios is not None else None)
     # a step above the critical one wrecks every shape too: then the step is named as well
     step = _time_step_hint(run) if not folding or run.deck.solver.dt_safety_factor < 1 else ""
-    return (f"; {folding}" if folding else "") + step + step_history(run.dt_history)
+    return (f"; {folding}" if folding else "") + _where_it_broke(run) + step + step_history(run.dt_history)
+
+
+def _where_it_broke(run: Run) -> str:
+    """Where the motion broke down: the nodes whose position or velocity is no longer a
+    number (how many, and where the first was at rest), else the fastest node; whether it
+    is a cable's node or a contact node touching a face. '' where nothing moves."""
+    s, model = run.sim.state, run.model
+    lost = ~(np.isfinite(s.x).all(axis=1) & np.isfinite(s.v).all(axis=1))
+    if lost.any():
+        nodes = np.flatnonzero(lost)
+        node, what = int(nodes[0]), f"{len(nodes)} node(s) no longer have a number for a position or velocity"
+    else:
+        speed = np.linalg.norm(s.v, axis=1)
+        node = int(np.argmax(speed))
+        if speed[node] == 0.0:
+            return ""
+        what = f"the fastest node moves at {speed[node]:.3g}"
+    on_shell = bool(np.any(model.conn == node))
+    return (f"; {what}: node {node + 1}, at {place(model.x0[node])} at rest"
+            + ("" if on_shell else ", on a cable alone") + contact_of_node(model, node))
 
 
 def _breaking_frame(run: Run, listener: Listener) -> None:

@@ -675,41 +675,22 @@ def couplings(t, model, shape, loads, step_u, nodes, blocks):
     translations (central differences of step ``step_u``; the pair and the fibre lengths
     held): nodes (K, 10) the node numbers and blocks (K, 30, 30) dF/dx, filled from the
     top. Returns how many pairs touch (or are held)."""
-    shape = _at_initial_thickness(model, shape)
-    grid = _grid(shape, loads, 1.0)
-    work = _work()
-    plus, minus = np.empty((10, 3)), np.empty((10, 3))
-    x = shape.x
-    count = 0
-    for m in range(loads.nodes.shape[0]):
-        row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
-        if row < 0:
-            continue
-        nodes[count, 0] = loads.nodes[m]
-        copy_into(loads.faces[row], nodes[count, 1:])
-        for j in range(30):
-            node, i = nodes[count, j // 3], j % 3
-            kept = x[node, i]
-            x[node, i] = kept + step_u
-            _pair_forces(x, shape.h, loads, m, row, plus, work)
-            x[node, i] = kept - step_u
-            _pair_forces(x, shape.h, loads, m, row, minus, work)
-            x[node, i] = kept
-            for a in range(10):
-                for k in range(3):
-                    blocks[count, 3 * a + k, j] = (plus[a, k] - minus[a, k]) / (2.0 * step_u)
-        count += 1
-    return count
+    return _differenced_pairs(model, shape, loads, (np.empty((0, 3)), 0.0), step_u, nodes, blocks, False)
 
 
 @njit(cache=True)
 def friction_couplings(t, model, shape, loads, motion, step_u, nodes, blocks):
-    """The derivative of each touching pair's friction with respect to its ten nodes'
-    translations, ``motion`` (v, rate): the nodes moving at v (n, 3) whose derivative by
-    the translations is ``rate`` (an implicit step's gamma / (beta dt)): central differences of step
-    ``step_u`` moving a node by it and its velocity by ``rate`` times it, the pair and the
-    fibre lengths held. nodes (K, 10), blocks (K, 30, 30) dF/dx as :func:`couplings`'s;
-    returns how many pairs with friction touch (or are held)."""
+    """The derivative of each touching pair's friction as :func:`couplings`'s, ``motion``
+    (v, rate): the nodes moving at v (n, 3) whose derivative by the translations is
+    ``rate`` (an implicit step's gamma / (beta dt)), so that a node moved by the step
+    moves by ``rate`` times it. Returns how many pairs with friction touch (or are held)."""
+    return _differenced_pairs(model, shape, loads, motion, step_u, nodes, blocks, True)
+
+
+@njit(cache=True)
+def _differenced_pairs(model, shape, loads, motion, step_u, nodes, blocks, friction):
+    """:func:`couplings` of the pairs' forces, or (``friction``) of their friction at the
+    velocities of ``motion`` (v (n, 3), rate) of the pairs with friction."""
     shape = _at_initial_thickness(model, shape)
     grid = _grid(shape, loads, 1.0)
     work = _work()
@@ -718,7 +699,7 @@ def friction_couplings(t, model, shape, loads, motion, step_u, nodes, blocks):
     x, (v, rate) = shape.x, motion
     count = 0
     for m in range(loads.nodes.shape[0]):
-        if loads.friction[m] == 0.0:
+        if friction and loads.friction[m] == 0.0:
             continue
         row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
         if row < 0:
@@ -727,14 +708,19 @@ def friction_couplings(t, model, shape, loads, motion, step_u, nodes, blocks):
         copy_into(loads.faces[row], nodes[count, 1:])
         for j in range(30):
             node, i = nodes[count, j // 3], j % 3
-            kept, kept_v = x[node, i], v[node, i]
+            kept = x[node, i]
+            kept_v = v[node, i] if friction else 0.0
             for side in range(2):
                 sign, out = (1.0, plus) if side == 0 else (-1.0, minus)
                 x[node, i] = kept + sign * step_u
-                v[node, i] = kept_v + sign * rate * step_u
-                _pair_forces(x, shape.h, loads, m, row, pushed, work)
-                _pair_friction(pushed, v, loads, m, row, out, scratch)
-            x[node, i], v[node, i] = kept, kept_v
+                if friction:
+                    v[node, i] = kept_v + sign * rate * step_u
+                    _pair_forces(x, shape.h, loads, m, row, pushed, work)
+                    _pair_friction(pushed, v, loads, m, row, out, scratch)
+                    v[node, i] = kept_v
+                else:
+                    _pair_forces(x, shape.h, loads, m, row, out, work)
+            x[node, i] = kept
             for a in range(10):
                 for k in range(3):
                     blocks[count, 3 * a + k, j] = (plus[a, k] - minus[a, k]) / (2.0 * step_u)

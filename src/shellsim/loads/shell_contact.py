@@ -301,18 +301,19 @@ def _holds(nodes, node):
 @njit(cache=True)
 def _grid(shape, loads, widening):
     """The search grid of the faces on the current shape: each face's box grown by the
-    largest reach of a contact (half its own largest and the largest node's fibre
-    length, times the offset, and the smoothing), times ``widening``. Returns (width,
-    origin) (:func:`build_grid`)."""
+    largest reach of a contact (half the largest node's fibre length times its offset and
+    the face's own largest times the largest offset, and the smoothing), times
+    ``widening``. Returns (width, origin) (:func:`build_grid`)."""
     h = shape.h
-    deepest = 0.0
+    deepest = widest = 0.0
     for m in range(loads.nodes.shape[0]):
         deepest = max(deepest, loads.offset[m] * h[loads.nodes[m]])
+        widest = max(widest, loads.offset[m])
     for f in range(loads.faces.shape[0]):
         thickest = 0.0
         for a in range(9):
             thickest = max(thickest, h[loads.faces[f, a]])
-        loads.reach[f] = 0.5 * (deepest + thickest) * (1.0 + TOUCHING) * widening
+        loads.reach[f] = 0.5 * (deepest + widest * thickest) * (1.0 + TOUCHING) * widening
     return build_grid(shape.x, loads.faces, loads.reach, (loads.boxes, loads.start, loads.entries))
 
 

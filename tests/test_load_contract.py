@@ -46,6 +46,8 @@ def test_a_contact_table_without_a_summary_or_with_a_friction_its_kind_cannot_ap
         check_kind(_copy(rigid_tool, TABLES=(Bare,)))
     with pytest.raises(TypeError, match="takes a friction, which the kind has no add_friction for"):
         check_kind(_copy(rigid_tool, ("add_friction",)))
+    with pytest.raises(TypeError, match="has friction_couplings without add_friction"):
+        check_kind(_copy(shell_contact, ("add_friction",)))
 
 
 def test_a_friction_on_a_contact_without_friction_is_refused_not_ignored(monkeypatch):

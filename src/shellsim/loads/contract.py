@@ -62,6 +62,9 @@ def check_kind(kind: ModuleType) -> str:
         if given and len(given) != len(pair):
             raise TypeError(f"{where} has {given[0]} without {', '.join(h for h in pair if h not in given)}: "
                             "they come together")
+    if hasattr(kind, "friction_couplings") and not hasattr(kind, "add_friction"):
+        raise TypeError(f"{where} has friction_couplings without add_friction: the derivative of a friction it "
+                        "does not apply")
     for table in kind.TABLES:
         absent = [hook for hook in TABLE_HOOKS[role] if not hasattr(table, hook)]
         if absent:
@@ -69,7 +72,4 @@ def check_kind(kind: ModuleType) -> str:
         if getattr(table, "FRICTION", False) and not hasattr(kind, "add_friction"):
             raise TypeError(f"{where}: its table {table.__name__} takes a friction, which the kind has no add_friction "
                             "for: give the table FRICTION = False, so a friction given is refused")
-        if hasattr(kind, "friction_couplings") and not hasattr(kind, "add_friction"):
-            raise TypeError(f"{where} has friction_couplings without add_friction: the derivative of a friction "
-                            "it does not apply")
     return role

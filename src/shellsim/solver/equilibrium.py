@@ -168,7 +168,8 @@ class Equilibrium:
 
     def _coupled(self) -> sp.coo_matrix | None:
         """The derivative of the forces that couple nodes sharing no element (contact
-        between shells, and its friction in an implicit step) over the unknowns, in the nodes' frames; None where there is none."""
+        between shells, and its friction in an implicit step) over the unknowns, in the
+        nodes' frames; None where there is none."""
         u, s = self.unknowns, self.sim.state
         motion = None if self.inertia is None else (s.v, self.inertia.velocity_rate)
         nodes, blocks = self._load_tangents.couplings(self._t, s.fields.shape, self.step_u, motion)

@@ -45,8 +45,9 @@ def stepping(end_time: float, dt: float, n_elements: int, contact: float = 0.0) 
 
 def contact_seconds(model: Model, t: float, shape: Shape) -> float:
     """The wall time [s] of every contact's forces (the search included) at time t on
-    ``shape``, as a time step evaluates them: 0 without contact. On a 10^4-element valve
-    it was a third of the step at rest, and grows as contact spreads."""
+    ``shape``, as a time step evaluates them: 0 without contact. On the synthetic
+    tricuspid valve (8,100 shells) 10 ms at rest against 33 ms of the shells' own step; it
+    grows as contact spreads."""
     forces = ToolForces(model, [])
     return forces.seconds_per_evaluation(t, shape, repeats=3) if forces.has_contact else 0.0
 
@@ -64,7 +65,8 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
     ``mass_factor`` the masses' factor that reaches it (1 without); ``steps``, the number
     of steps of ``dt`` to the end time (a stiffening scene takes more); ``seconds``, about
     how long they take, ``contact_share`` the contacts' share of that (timed at rest), and
-    ``bytes``, the memory the run holds. ``on_product(count)`` is told each stiffness product of the estimates."""
+    ``bytes``, the memory the run holds. ``on_product(count)`` is told each stiffness
+    product of the estimates."""
     initial = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
     critical = {mass: stable_step(model, initial, Simulation(model._replace(mass=mass)).critical_time_step(on_product))
                 for mass in ("M1", "M2")}

@@ -1,6 +1,7 @@
 """The energies of a static solve: the internal work and the external work (the loads'
-and the supports' reactions on prescribed motion; in an implicit one, friction's apart), summed by the trapezoidal rule between
-converged load steps, as the explicit loop sums them between time steps.
+and the supports' reactions on prescribed motion; in an implicit one, friction's apart),
+summed by the trapezoidal rule between converged load steps, as the explicit loop sums
+them between time steps.
 
 At equilibrium the two differ only by the work of the residual the steps converged to,
 so their balance measures how well the path was solved; the internal work is the strain

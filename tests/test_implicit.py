@@ -65,3 +65,23 @@ def test_a_slack_cable_falls_to_the_exact_elastic_catenary_where_a_static_solve_
     the explicit run's (8.1e-3, the 8 segments' discretisation)."""
     sag, across = hanging_cable_errors(8, 'method = "implicit"\nimplicit = { increments = 60, alpha = -0.3333 }')
     assert 7e-3 < sag < 9e-3 and across < sag
+
+
+def test_check_times_a_tangent_and_its_factors_for_the_implicit_path(tmp_path):
+    """``check`` of the plate as an implicit deck forms a tangent at rest and factorises
+    it, and says how long that took on this machine, beside the unknowns (5 per node)."""
+    import re
+
+    from typer.testing import CliRunner
+
+    from shellsim.cli import app
+    from shellsim.geometry import build_mesh
+
+    text = PLATE.read_text().replace("end_time = 0.18", 'end_time = 0.18\nmethod = "implicit"')
+    deck = tmp_path / "plate.toml"
+    deck.write_text(text)
+    result = CliRunner().invoke(app, ["check", str(deck)], env={"COLUMNS": "60"})
+    said = " ".join(result.output.replace("│", " ").split())
+    assert result.exit_code == 0, result.output
+    unknowns = 5 * len(build_mesh(parse_deck(text)).x)
+    assert re.search(rf"{unknowns:,} unknowns; about [\d.e+-]+ (s|min|h) per tangent on this machine", said), said

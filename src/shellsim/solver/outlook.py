@@ -2,15 +2,18 @@
 and the wall time they take; a scene that cannot fit in memory or finish in a year is
 refused with the numbers that say why.
 
-The rates are measured on this project's reference machine (docs/verification.md,
-"Cost of a scene"): one step of a group of 16 elements takes about 130 us on one thread;
-the memory a run holds is :mod:`shellsim.memory`'s.
+The explicit step's rate is measured on this project's reference machine
+(docs/verification.md, "Cost of a scene"): one step of a group of 16 elements takes
+about 130 us on one thread; the contacts' forces and a Newton path's tangent are timed on
+the scene itself; the memory a run holds is :mod:`shellsim.memory`'s.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
+from contextlib import suppress
 
 from numba import get_num_threads
 
@@ -18,12 +21,13 @@ from ..bundles import Shape
 from ..deck import Deck
 from ..deck.schema import Solver
 from ..element.groups import group_count
-from ..element.tangent import FORWARD_BATCHES
 from ..errors import SceneTooLarge
 from ..memory import memory_bytes
 from ..model import Model
 from ..loads import ToolForces, stable_step
+from .equilibrium import Equilibrium
 from .simulation import Simulation
+from .sparse_lu import SymmetricPatternLU
 
 SECONDS_PER_GROUP_STEP = 130e-6
 #: A run longer than this is not one anybody will wait for: it is refused.
@@ -82,11 +86,20 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
 
 
 def static_outlook(model: Model) -> dict:
-    """What a static solve will hold and cost per tangent: ``unknowns`` (5 DOF per node,
-    supports' included), ``seconds`` per tangent on this machine's threads, ``bytes``."""
-    # an element's tangent takes FORWARD_BATCHES evaluations of a group
-    seconds = FORWARD_BATCHES * model.n_elements * SECONDS_PER_GROUP_STEP / max(1, get_num_threads())
-    return {"unknowns": 5 * model.n_nodes, "seconds": seconds, "bytes": memory_bytes(model.n_elements)}
+    """What a static or implicit solve will hold and cost per tangent: ``unknowns`` (5 DOF
+    per node, supports' included), ``seconds`` to form a tangent at rest and factorise it
+    on this machine's threads (timed: the rate per element said 0.056 s where the aortic
+    valve's tangent and factors took 0.22 s, the follower pressure's and the contact's
+    tangents and the factors left out), ``bytes``."""
+    equilibrium = Equilibrium(Simulation(model))
+    equilibrium.evaluate(0.0)
+    equilibrium.tangent()  # the first call may compile the kernels
+    start = time.perf_counter()
+    tangent = equilibrium.tangent()
+    with suppress(RuntimeError):  # singular at rest (a slack chord's nodes): the forming's time alone
+        SymmetricPatternLU(tangent[:, :equilibrium.unknowns.n_free])
+    return {"unknowns": 5 * model.n_nodes, "seconds": time.perf_counter() - start,
+            "bytes": memory_bytes(model.n_elements)}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:

@@ -197,3 +197,12 @@ def test_deck_text_is_shown_as_written_never_read_as_markup_or_tex(tmp_path):
     plotted = runner.invoke(app, ["plot", str(tmp_path / "out")])
     assert plotted.exit_code == 0, plotted.output
     assert (tmp_path / "out" / "plots" / "tip.png").exists() and (tmp_path / "out" / "plots" / "energy.png").exists()
+
+
+def test_durations_read_as_a_person_writes_them():
+    """Seconds below ten with two figures, whole seconds to two minutes (108 s, never
+    1.1e+02 s), then minutes, hours, days and years."""
+    from shellsim.solver.outlook import duration
+
+    assert [duration(s) for s in (3.24, 108.4, 840.0, 5.1 * 3600, 3 * 86400)] == \
+        ["3.2 s", "108 s", "14 min", "5.1 h", "3 days"]

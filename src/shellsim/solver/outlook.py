@@ -115,9 +115,11 @@ def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:
 
 
 def duration(seconds: float) -> str:
-    """'3.2 s', '14 min', '5.1 h', '2.3e+04 years'."""
-    if seconds < 120:
+    """'3.2 s', '108 s', '14 min', '5.1 h', '2.3e+04 years'."""
+    if seconds < 10:
         return f"{seconds:.2g} s"
+    if seconds < 120:
+        return f"{seconds:.0f} s"
     if seconds < 7200:
         return f"{seconds / 60:.2g} min"
     if seconds < 2 * 86400:

@@ -105,8 +105,9 @@ def build_model(deck: Deck, mesh: Mesh) -> Model:
 
 def relax_from(deck: Deck, curves) -> float:
     """When kinetic damping starts (inf: the deck relaxes nothing): once every contact's
-    moving curve (a rigid tool's motion) has stopped. A reset stops the nodes a tool is pushing while it goes on:
-    it then runs into them, and the penalty's impulse folded a crushed ring's elements."""
+    moving curve (a rigid tool's motion) has stopped. A reset stops the nodes a tool is
+    pushing while it goes on: it then runs into them, and the penalty's impulse folded a
+    crushed ring's elements."""
     if deck.solver.relaxation is None:
         return math.inf
     moving = [deck.curve_index(table.moving_curve) for table in deck.contact if table.moving_curve is not None]

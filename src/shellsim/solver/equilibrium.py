@@ -95,7 +95,7 @@ class Equilibrium:
             np.subtract(s.d, c["d"], out=space.dd)
             s.stress[:] = c["stress"]
             s.h[:] = c["h"]
-        if self.inertia is not None:
+        if self.inertia is not None and self.sim.workspace.friction:
             self.inertia.move_velocities()  # the contacts' friction opposes them
         self.sim.compute_forces(t)
 

@@ -6,7 +6,7 @@ the file (``read_foreign``) and the whole ``shellsim import`` (mesh file, id map
 written, the deck checked against the mesh read back). Prints a Markdown table; nothing is
 asserted.
 
-    .venv/bin/python benchmarks/import_size.py [--circumferential 54 --radial 50 --segments 25] [--repeats 3]
+    .venv/bin/python benchmarks/import_size.py [--circumferential 54 --belly 40 --band 10 --segments 25] [--repeats 3]
 """
 
 from __future__ import annotations
@@ -26,11 +26,11 @@ def main() -> None:
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     defaults = SyntheticValve()
-    for key in ("circumferential", "radial", "segments"):
+    for key in ("circumferential", "belly", "band", "segments"):
         parser.add_argument(f"--{key}", type=int, default=getattr(defaults, key))
     parser.add_argument("--repeats", type=int, default=3)
     options = parser.parse_args()
-    valve = SyntheticValve(options.circumferential, options.radial, options.segments)
+    valve = SyntheticValve(options.circumferential, options.belly, options.band, options.segments)
     law = UserLaw.parse("lee_sacks: c0 = $1, c1 = $2, c2 = $3, c3 = 0, delta = 1")
     folder = Path(tempfile.mkdtemp())
     source = folder / "valve.inp"

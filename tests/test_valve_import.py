@@ -14,16 +14,18 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from scipy.spatial import cKDTree
+
 from shellsim.cli import app
 from shellsim.deck import load_deck
 from shellsim.foreign.user_law import UserLaw
 from shellsim.geometry.importing import read_mesh
 from shellsim.imported_deck import import_model
 from shellsim.verify.synthetic_valve import (CHORD_LAWS, FRICTION, LEAFLET_LAWS, LEAFLETS, MASS_SCALING_STEP,
-                                             OVERCLOSURE_STIFFNESS, SyntheticValve, abaqus_text, febio_text)
+                                             OVERCLOSURE_STIFFNESS, SHAPE, SyntheticValve, abaqus_text, febio_text)
 
-#: A small valve: 3 x 4 x 3 = 36 shells, 12 chords of 3 elements to 6 tips.
-VALVE = SyntheticValve(circumferential=4, radial=3, segments=3, tips=6)
+#: A small valve: 3 x 4 x (2 + 1) = 36 shells, 15 chords of 3 elements to 6 tips.
+VALVE = SyntheticValve(circumferential=4, belly=2, band=1, segments=3, tips=6)
 LEE_SACKS = UserLaw.parse("lee_sacks: c0 = $1, c1 = $2, c2 = $3, c3 = 0, delta = 1")
 
 
@@ -33,6 +35,29 @@ def imported(tmp_path_factory):
     source = folder / "valve.inp"
     source.write_text(abaqus_text(VALVE))
     return import_model(source, folder / "deck", LEE_SACKS)
+
+
+def test_the_generated_leaflets_start_apart_near_closed_and_face_the_ventricle():
+    """The builder's leaflets upside down: each leaflet's nodes the shape's gap from its
+    neighbours' (no overlap at rest, the bands ready to meet), the free edges at z = -12,
+    each attachment's middle on the annulus (radius 15, z = 0), and every shell's normal
+    toward the ventricle (down, and on the upright bands toward the leaflet's own side,
+    e_g), so that the pressure on SPOS lifts the bellies and presses the bands together."""
+    valve = SyntheticValve(circumferential=8, belly=4, band=2, segments=3, tips=6)
+    leaflet_of = {node: g for _, g, corners in valve.shells for node in corners}
+    by_leaflet = [np.array([p for label, p in valve.points.items() if leaflet_of[label] == g]) for g in range(3)]
+    for g in range(3):
+        nearest, _ = cKDTree(by_leaflet[(g + 1) % 3]).query(by_leaflet[g])
+        assert nearest.min() == pytest.approx(SHAPE.gap, rel=1e-12)
+        assert valve.points[valve.node(g, valve.rows, 4)][2] == pytest.approx(-SHAPE.height)
+        middle = valve.points[valve.node(g, 0, 4)]
+        assert (np.hypot(middle[0], middle[1]), middle[2]) == pytest.approx((SHAPE.base_radius, 0.0), abs=1e-12)
+    for _, g, corners in valve.shells:
+        a, b, c, d = (valve.points[n] for n in corners)
+        side = np.radians(90.0 + 120.0 * g)
+        normal = np.cross(c - a, d - b)
+        assert normal[2] < 0.0 or (normal[2] == pytest.approx(0.0, abs=1e-12) and
+                                   normal @ [np.cos(side), np.sin(side), 0.0] > 0.0)
 
 
 def test_the_imported_valve_checks_as_written(imported):
@@ -75,7 +100,7 @@ def test_every_chord_comes_over_with_its_group_s_law_and_mass_scaling(imported):
     for cable, terms in zip(deck.cable, CHORD_LAWS):
         assert cable.law.terms() == ([mu for mu, _ in terms], [alpha for _, alpha in terms])
         assert cable.min_step == MASS_SCALING_STEP
-    assert imported.cables == len(VALVE.chords[1]) == 3 * 4 * 3
+    assert imported.cables == len(VALVE.chords[1]) == 3 * 5 * 3
     assert deck.solver.mass_scaling is None
 
 
@@ -110,7 +135,7 @@ def test_the_file_s_ids_are_kept_in_the_mesh_and_the_id_map(imported):
     mesh = read_mesh(imported.mesh)
     rows = list(csv.DictReader(imported.ids.open()))
     nodes = {int(r["label"]): int(r["index"]) for r in rows if r["kind"] == "node"}
-    positions = {VALVE.node(i, j): p for i, ring in enumerate(VALVE.funnel) for j, p in enumerate(ring)}
+    positions = dict(VALVE.points)
     positions |= {label: p for label, _, p in VALVE.tip_positions} | dict(VALVE.chords[0])
     assert set(nodes) == set(positions)
     for label, index in nodes.items():

@@ -2,18 +2,24 @@
 with every feature a patient-specific valve model for Abaqus/Explicit carries: the shapes
 and numbers are made up, the features are those of such a model.
 
-Geometry (mm): three leaflets of S4R shells, each a third of a funnel from the annulus
-(radius 15, z = 0) down to the free edge (radius 6.75, z = -12), ``circumferential``
-elements across each leaflet and ``radial`` from annulus to free edge (54 x 50 x 3 =
-8,100 by default); a chord of ``segments`` T3D2 elements from each free-edge node down
-to one of ``tips`` papillary tips (z = -25) in three groups, one under each leaflet
-(162 chords of 25 elements, 4,050, by default).
+Geometry (mm): three separate leaflets of S4R shells in a near-closed position, each the
+aortic valve builder's leaflet (:func:`shellsim.geometry.builders.valve_points`) turned
+upside down: a belly from its attachment (the annulus, radius 15 at z = 0 under the
+leaflet's middle, rising to short commissure posts at radius 12.5 on either side) down to
+a vertical coaptation band 3 mm tall, whose lower edge is the free edge, at z = -12, along
+the two lines from the commissures to the axis, 0.5 mm from its neighbours'.
+``circumferential`` elements across each leaflet, ``belly`` + ``band`` from attachment to
+free edge (54 x (40 + 10) x 3 = 8,100 by default). A chord of ``segments`` T3D2 elements
+from each free-edge node down to one of ``tips`` papillary tips (z = -25) in three groups,
+one under each leaflet (165 chords of 25 elements, 4,125, by default). Under the
+ventricle's pressure the bellies rise and the bands press together, as the aortic
+valve's do under the aorta's; the chordae keep the free edges from turning up.
 
 Abaqus file (mm-tonne-s, MPa):
 - each leaflet its own ``*SHELL SECTION`` (0.4 mm, 5 section points) and material of one
   user law, W = C0/2 (I1 - 3) + C1/2 (exp(C2 (I1 - 3)^2) - 1), C2 = 4.57, 14.86 and 17.75
   (the valve model's spread; C0 = 0.001 and C1 = 0.0005 MPa are illustrative);
-- a per-element ``*ORIENTATION`` (``*DISTRIBUTION``) along the circumference;
+- a per-element ``*ORIENTATION`` (``*DISTRIBUTION``) along the free edge;
 - each chord group its own ``*HYPERELASTIC, OGDEN, N=3`` law: two write one term as three
   of equal exponent, the third has two distinct terms (illustrative constants);
 - per-node annulus motion (each node its own displacement, on an amplitude), papillary
@@ -26,7 +32,7 @@ Holzapfel-Gasser-Ogden constants with a per-element ``mat_axis``, three beam dom
 linear trusses, the tips held, the annulus moved, a pressure on a load controller,
 sliding contact of the leaflets with friction, a dynamic step.
 
-    python -m shellsim.verify.synthetic_valve valve.inp [--circumferential 54 --radial 50 ...]
+    python -m shellsim.verify.synthetic_valve valve.inp [--circumferential 54 --belly 40 ...]
 """
 
 from __future__ import annotations
@@ -38,7 +44,13 @@ from pathlib import Path
 
 import numpy as np
 
-ANNULUS_RADIUS, FREE_EDGE_RADIUS, DEPTH, TIP_DEPTH, TIP_RADIUS = 15.0, 6.75, 12.0, 25.0, 4.5
+from ..deck.geometry import AorticValve
+from ..geometry.builders import valve_points
+
+#: The leaflets' shape: the aortic valve builder's, turned upside down [mm].
+SHAPE = AorticValve(builder="aortic_valve", commissure_radius=12.5, base_radius=15.0, height=12.0,
+                    coaptation_height=3.0, gap=0.5)
+TIP_DEPTH, TIP_INWARD = 25.0, 0.6
 THICKNESS, SECTION_POINTS, CHORD_AREA, DENSITY = 0.4, 5, 0.4, 1.1e-9
 #: The leaflets' user-law constants (C0, C1, C2) [MPa, MPa, -].
 LEAFLET_LAWS = ((0.001, 0.0005, 4.57), (0.001, 0.0005, 14.86), (0.001, 0.0005, 17.75))
@@ -50,89 +62,126 @@ FRICTION, OVERCLOSURE_STIFFNESS, MASS_SCALING_STEP = 0.01, 10.0, 5e-5
 LEAFLETS = ("Anterior", "Posterior", "Septal")
 
 
+def _leaflet_points(g: int, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """(n, 3) leaflet g's points at u (n,) from commissure to commissure and y (n,) from
+    the attachment (0) to the free edge (1): the builder's, z turned over."""
+    return valve_points(SHAPE, np.full(len(u), g), u, y) * [1.0, 1.0, -1.0]
+
+
 @dataclass(frozen=True)
 class SyntheticValve:
-    """The valve's mesh: node labels from 1, shell labels from 1, chord labels after."""
+    """The valve's mesh: node labels from 1, leaflet by leaflet and row by row from the
+    attachment, then the tips and the chords' own nodes; shell labels from 1, chord
+    labels after."""
 
     circumferential: int = 54
-    radial: int = 50
+    belly: int = 40
+    band: int = 10
     segments: int = 25
     tips: int = 32
 
     @property
-    def ring(self) -> int:
-        """Nodes around one ring of the funnel."""
-        return 3 * self.circumferential
+    def rows(self) -> int:
+        """Rows of shells from the attachment to the free edge."""
+        return self.belly + self.band
 
-    def node(self, i: int, j: int) -> int:
-        """The label of the funnel's node ``i`` rings from the annulus, ``j`` around."""
-        return 1 + i * self.ring + j % self.ring
+    def node(self, g: int, i: int, j: int) -> int:
+        """The label of leaflet ``g``'s node on row ``i`` (0: the attachment) and column
+        ``j`` (0 to ``circumferential``, commissure to commissure)."""
+        return 1 + (g * (self.rows + 1) + i) * (self.circumferential + 1) + j
+
+    def _parameters(self, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """u and y of rows i and columns j: the belly's rows over y < 1/2, the band's over
+        the rest."""
+        y = np.where(i <= self.belly, 0.5 * i / self.belly, 0.5 + 0.5 * (i - self.belly) / self.band)
+        return j / self.circumferential, y
 
     @cached_property
-    def funnel(self) -> np.ndarray:
-        """(rings, ring, 3) the funnel's node positions."""
-        s = np.linspace(0.0, 1.0, self.radial + 1)[:, None]
-        theta = np.linspace(0.0, 2 * np.pi, self.ring, endpoint=False)[None]
-        r = ANNULUS_RADIUS + (FREE_EDGE_RADIUS - ANNULUS_RADIUS) * s
-        z = np.broadcast_to(-DEPTH * s, (len(s), self.ring))
-        return np.stack([r * np.cos(theta), r * np.sin(theta), z], axis=-1)
+    def points(self) -> dict[int, np.ndarray]:
+        """{label: position (3,)} of the leaflets' nodes."""
+        i, j = (a.ravel() for a in np.mgrid[0:self.rows + 1, 0:self.circumferential + 1])
+        u, y = self._parameters(i, j)
+        return {self.node(g, a, b): p for g in range(3)
+                for a, b, p in zip(i, j, _leaflet_points(g, u, y))}
 
     @cached_property
     def shells(self) -> list[tuple[int, int, list[int]]]:
         """(label, leaflet, corners) of each shell, its corners turning so that its normal
-        points out of the funnel and down: a pressure on SPOS pushes it in, to close."""
+        points to the ventricle (down and out, toward its own leaflet's side): a pressure
+        on SPOS pushes the bellies up and the bands together, to close."""
         out = []
-        for i in range(self.radial):
-            for j in range(self.ring):
-                corners = [self.node(i, j), self.node(i + 1, j), self.node(i + 1, j + 1), self.node(i, j + 1)]
-                out.append((len(out) + 1, j // self.circumferential, corners))
+        for g in range(3):
+            for i in range(self.rows):
+                for j in range(self.circumferential):
+                    corners = [self.node(g, i, j), self.node(g, i, j + 1), self.node(g, i + 1, j + 1),
+                               self.node(g, i + 1, j)]
+                    a, b, _, d = (self.points[n] for n in corners)
+                    side = [np.cos(np.radians(90.0 + 120.0 * g)), np.sin(np.radians(90.0 + 120.0 * g)), -1.0]
+                    if np.dot(np.cross(b - a, d - a), side) < 0.0:
+                        corners.reverse()
+                    out.append((len(out) + 1, g, corners))
         return out
 
     @cached_property
     def tip_positions(self) -> list[tuple[int, int, np.ndarray]]:
-        """(label, group, position) of each papillary tip, spread under its leaflet."""
-        out, label = [], self.node(self.radial + 1, 0)
+        """(label, group, position) of each papillary tip: spread under its leaflet's free
+        edge, drawn in toward the axis."""
+        out, label = [], max(self.points) + 1
         for g in range(3):
             count = self.tips // 3 + (g < self.tips % 3)
-            for k in range(count):
-                angle = 2 * np.pi * (g + (k + 0.5) / count) / 3
-                out.append((label, g, np.array([TIP_RADIUS * np.cos(angle), TIP_RADIUS * np.sin(angle), -TIP_DEPTH])))
+            u = (np.arange(count) + 0.5) / count
+            edge = _leaflet_points(g, u, np.ones(count))
+            for p in edge:
+                out.append((label, g, np.array([TIP_INWARD * p[0], TIP_INWARD * p[1], -TIP_DEPTH])))
                 label += 1
         return out
 
     @cached_property
     def chords(self) -> tuple[list[tuple[int, np.ndarray]], list[tuple[int, int, int, int]]]:
         """(label, position) of the chords' own nodes and (label, group, end, end) of
-        their elements: a chord from each free-edge node to a tip of its leaflet's group."""
+        their elements: a chord from each free-edge node to the nearest tip along its
+        leaflet's edge."""
         nodes, elements = [], []
         label = self.tip_positions[-1][0] + 1
         element = len(self.shells) + 1
         tips = [[t for t in self.tip_positions if t[1] == g] for g in range(3)]
-        for j in range(self.ring):
-            g, k = divmod(j, self.circumferential)
-            tip_label, _, tip = tips[g][k * len(tips[g]) // self.circumferential]
-            start = self.funnel[self.radial, j]
-            chain = [self.node(self.radial, j)]
-            for m in range(1, self.segments):
-                nodes.append((label, start + m / self.segments * (tip - start)))
-                chain.append(label)
-                label += 1
-            chain.append(tip_label)
-            for a, b in zip(chain, chain[1:]):
-                elements.append((element, g, a, b))
-                element += 1
+        edge = self.circumferential + 1
+        for g in range(3):
+            for k in range(edge):
+                tip_label, _, tip = tips[g][min(k * len(tips[g]) // edge, len(tips[g]) - 1)]
+                end = self.node(g, self.rows, k)
+                start = self.points[end]
+                chain = [end]
+                for m in range(1, self.segments):
+                    nodes.append((label, start + m / self.segments * (tip - start)))
+                    chain.append(label)
+                    label += 1
+                chain.append(tip_label)
+                for a, b in zip(chain, chain[1:]):
+                    elements.append((element, g, a, b))
+                    element += 1
         return nodes, elements
 
     def circumferential_axes(self) -> np.ndarray:
-        """(shells, 3) the unit circumferential direction at each shell's centre."""
-        theta = 2 * np.pi * (np.arange(len(self.shells)) % self.ring + 0.5) / self.ring
-        return np.column_stack([-np.sin(theta), np.cos(theta), np.zeros_like(theta)])
+        """(shells, 3) each shell's unit direction along its leaflet's free edge (growing
+        u) at its centre, where the collagen runs."""
+        i, j = (a.ravel() for a in np.mgrid[0:self.rows, 0:self.circumferential])
+        u, y = self._parameters(i + 0.5, j + 0.5)
+        step = 1e-6
+        along = np.concatenate([_leaflet_points(g, u + step, y) - _leaflet_points(g, u - step, y) for g in range(3)])
+        return along / np.linalg.norm(along, axis=1, keepdims=True)
 
     def annulus_motion(self) -> list[tuple[int, np.ndarray]]:
-        """(label, displacement) of each annulus node: 5% inward and a saddle of 0.5 mm."""
-        theta = np.linspace(0.0, 2 * np.pi, self.ring, endpoint=False)
-        return [(self.node(0, j), np.array([-0.05 * ANNULUS_RADIUS * np.cos(t), -0.05 * ANNULUS_RADIUS * np.sin(t),
-                                            0.5 * np.cos(2 * t)])) for j, t in enumerate(theta)]
+        """(label, displacement) of each attached node (the annulus and the commissure
+        posts): 5% inward and a saddle of 0.5 mm."""
+        attached = {self.node(g, i, j) for g in range(3) for i in range(self.rows + 1)
+                    for j in ((0, self.circumferential) if i else range(self.circumferential + 1))}
+        out = []
+        for label in sorted(attached):
+            x, y, _ = self.points[label]
+            t = np.arctan2(y, x)
+            out.append((label, np.array([-0.05 * x, -0.05 * y, 0.5 * np.cos(2 * t)])))
+        return out
 
 
 def _lines(values, per_line: int = 8) -> list[str]:
@@ -149,8 +198,7 @@ def abaqus_text(valve: SyntheticValve) -> str:
     """The valve as an Abaqus/Explicit input file."""
     out = ["*Heading", " Synthetic tricuspid valve: three leaflets, chordae, annulus motion, 23 mmHg",
            "** Units: mm, tonne, s, N, MPa", "*Node"]
-    out += [f"{valve.node(i, j)}, {x:.12g}, {y:.12g}, {z:.12g}" for i, ring in enumerate(valve.funnel)
-            for j, (x, y, z) in enumerate(ring)]
+    out += [f"{label}, {x:.12g}, {y:.12g}, {z:.12g}" for label, (x, y, z) in valve.points.items()]
     out += [f"{label}, {x:.12g}, {y:.12g}, {z:.12g}" for label, _, (x, y, z) in valve.tip_positions]
     chord_nodes, chord_elements = valve.chords
     out += [f"{label}, {x:.12g}, {y:.12g}, {z:.12g}" for label, (x, y, z) in chord_nodes]
@@ -195,7 +243,7 @@ def abaqus_text(valve: SyntheticValve) -> str:
 def febio_text(valve: SyntheticValve) -> str:
     """The valve as a FEBio 4.0 file: HGO leaflets, linear-truss chordae."""
     chord_nodes, chord_elements = valve.chords
-    nodes = [(valve.node(i, j), p) for i, ring in enumerate(valve.funnel) for j, p in enumerate(ring)]
+    nodes = list(valve.points.items())
     nodes += [(label, p) for label, _, p in valve.tip_positions] + chord_nodes
     xyz = "".join(f'<node id="{label}">{x:.12g},{y:.12g},{z:.12g}</node>' for label, (x, y, z) in nodes)
     materials, domains, elements = [], [], []
@@ -260,10 +308,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("path", type=Path, help="the file to write: .inp (Abaqus) or .feb (FEBio)")
     defaults = SyntheticValve()
-    for key in ("circumferential", "radial", "segments", "tips"):
+    for key in ("circumferential", "belly", "band", "segments", "tips"):
         parser.add_argument(f"--{key}", type=int, default=getattr(defaults, key))
     options = parser.parse_args()
-    valve = SyntheticValve(options.circumferential, options.radial, options.segments, options.tips)
+    valve = SyntheticValve(options.circumferential, options.belly, options.band, options.segments, options.tips)
     writer = febio_text if options.path.suffix.lower() == ".feb" else abaqus_text
     options.path.write_text(writer(valve))
     print(f"wrote {options.path}: {len(valve.shells)} shells, {len(valve.chords[1])} chord elements")

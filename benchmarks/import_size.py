@@ -1,12 +1,12 @@
 """Wall time of bringing a valve engineer's Abaqus model over: the synthetic tricuspid valve
 of :mod:`shellsim.verify.synthetic_valve` (8,100 S4R shells in three leaflets of one user
-law, 4,050 T3D2 chordae in three Ogden groups, per-node annulus motion, contact, ...; its
+law, 4,095 T3D2 chordae in three Ogden groups, per-node annulus motion, contact, ...; its
 size set by the options), imported with the user law mapped onto Lee-Sacks. Times reading
 the file (``read_foreign``) and the whole ``shellsim import`` (mesh file, id map and deck
 written, the deck checked against the mesh read back). Prints a Markdown table; nothing is
 asserted.
 
-    .venv/bin/python benchmarks/import_size.py [--circumferential 54 --belly 40 --band 10 --segments 25] [--repeats 3]
+    .venv/bin/python benchmarks/import_size.py [--circumferential 90 --belly 24 --band 6 --segments 15] [--repeats 3]
 """
 
 from __future__ import annotations

@@ -9,11 +9,13 @@ leaflet's middle, rising to short commissure posts at radius 12.5 on either side
 a vertical coaptation band 3 mm tall, whose lower edge is the free edge, at z = -12, along
 the two lines from the commissures to the axis, 0.5 mm from its neighbours'.
 ``circumferential`` elements across each leaflet, ``belly`` + ``band`` from attachment to
-free edge (54 x (40 + 10) x 3 = 8,100 by default). A chord of ``segments`` T3D2 elements
-from each free-edge node down to one of ``tips`` papillary tips (z = -25) in three groups,
-one under each leaflet (165 chords of 25 elements, 4,125, by default). Under the
-ventricle's pressure the bellies rise and the bands press together, as the aortic
-valve's do under the aorta's; the chordae keep the free edges from turning up.
+free edge (90 x (24 + 6) x 3 = 8,100 by default: beside the posts, where the belly's
+sections are shortest, its rows are 0.19 mm, near the free edge's 0.28 mm columns). A
+chord of ``segments`` T3D2 elements from each free-edge node down to one of ``tips``
+papillary tips (z = -25) in three groups, one under each leaflet (273 chords of 15
+elements, 4,095, by default). Under the ventricle's pressure the bellies rise and the
+bands press together, as the aortic valve's do under the aorta's; the chordae keep the
+free edges from turning up.
 
 Abaqus file (mm-tonne-s, MPa):
 - each leaflet its own ``*SHELL SECTION`` (0.4 mm, 5 section points) and material of one
@@ -32,7 +34,7 @@ Holzapfel-Gasser-Ogden constants with a per-element ``mat_axis``, three beam dom
 linear trusses, the tips held, the annulus moved, a pressure on a load controller,
 sliding contact of the leaflets with friction, a dynamic step.
 
-    python -m shellsim.verify.synthetic_valve valve.inp [--circumferential 54 --belly 40 ...]
+    python -m shellsim.verify.synthetic_valve valve.inp [--circumferential 90 --belly 24 ...]
 """
 
 from __future__ import annotations
@@ -74,10 +76,10 @@ class SyntheticValve:
     attachment, then the tips and the chords' own nodes; shell labels from 1, chord
     labels after."""
 
-    circumferential: int = 54
-    belly: int = 40
-    band: int = 10
-    segments: int = 25
+    circumferential: int = 90
+    belly: int = 24
+    band: int = 6
+    segments: int = 15
     tips: int = 32
 
     @property
@@ -111,12 +113,12 @@ class SyntheticValve:
         on SPOS pushes the bellies up and the bands together, to close."""
         out = []
         for g in range(3):
+            side = [np.cos(np.radians(90.0 + 120.0 * g)), np.sin(np.radians(90.0 + 120.0 * g)), -1.0]
             for i in range(self.rows):
                 for j in range(self.circumferential):
                     corners = [self.node(g, i, j), self.node(g, i, j + 1), self.node(g, i + 1, j + 1),
                                self.node(g, i + 1, j)]
                     a, b, _, d = (self.points[n] for n in corners)
-                    side = [np.cos(np.radians(90.0 + 120.0 * g)), np.sin(np.radians(90.0 + 120.0 * g)), -1.0]
                     if np.dot(np.cross(b - a, d - a), side) < 0.0:
                         corners.reverse()
                     out.append((len(out) + 1, g, corners))

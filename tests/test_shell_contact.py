@@ -517,3 +517,38 @@ own_surface_limit = {limit}
         np.testing.assert_allclose(contact.offset, 0.4 * 0.05 / 0.06, rtol=1e-9)
     else:
         assert np.count_nonzero(contact.initial_depth > 0.0) > len(contact.nodes) / 2
+
+
+def test_a_face_s_search_box_is_grown_by_the_reach_of_its_own_pass(tmp_path):
+    """Two strips in one self-contact (nodes 0.05 apart, 0.06 thick, 1 apart): a strip's
+    faces, searched by its own nodes, have their boxes grown by those nodes' limited reach
+    (0.4 x the spacing: offset 0.4 x 0.05 / 0.06, (0.02 + 0.02) / 2); searched by the other
+    strip's nodes, by the whole thickness ((0.06 + 0.06) / 2). Grown by the table's largest,
+    every face of a node's own surface near it had its nearest point searched."""
+    from shellsim.loads.penalty_law import TOUCHING
+    from shellsim.loads.shell_contact import _grid
+    from shellsim.mesh import Mesh
+    from shellsim.model import build_model
+
+    strips = []
+    for level in range(2):
+        strip = build_mesh(parse_deck(deck_text('builder = "rectangle"\nlength = 1.0\nwidth = 0.2',
+                                                "[mesh]\ndivisions = { length = 10, width = 2 }\n")))
+        strip.x[:, 2] += level
+        strips.append(strip)
+    n = strips[0].n_nodes
+    path = tmp_path / "strips.vtu"
+    write_mesh_vtu(Mesh(x=np.vstack([s.x for s in strips]), conn=np.vstack([strips[0].conn, strips[1].conn + n]),
+                        director=np.vstack([s.director for s in strips]), thickness=np.full(2 * n, 0.06),
+                        sets={"strips": NamedSet("surface", np.arange(2 * n), elements=np.arange(40))}), path)
+    deck = parse_deck(deck_text(f'builder = "file"\npath = "{path.as_posix()}"',
+                                '[[contact]]\ntype = "shells"\nname = "both"\nset = "strips"\n'))
+    model = build_model(deck, build_mesh(deck))
+    loads = model.loads.shell_contact
+    _grid(initial_shape(model), loads, 1.0)
+    face_strip = loads.face_elements // 20
+    node_strip = {int(g): int(loads.nodes[loads.group == g][0] >= n) for g in np.unique(loads.group)}
+    own = np.array([node_strip[int(g)] == s for g, s in zip(loads.face_group, face_strip)])
+    assert own.any() and not own.all()
+    np.testing.assert_allclose(loads.reach[own], 0.02 * (1.0 + TOUCHING), rtol=1e-9)
+    np.testing.assert_allclose(loads.reach[~own], 0.06 * (1.0 + TOUCHING), rtol=1e-9)

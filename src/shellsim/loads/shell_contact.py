@@ -301,19 +301,30 @@ def _holds(nodes, node):
 @njit(cache=True)
 def _grid(shape, loads, widening):
     """The search grid of the faces on the current shape: each face's box grown by the
-    largest reach of a contact (half the largest node's fibre length times its offset and
-    the face's own largest times the largest offset, and the smoothing), times
-    ``widening``. Returns (width, origin) (:func:`build_grid`)."""
+    largest reach of the nodes tested against it (those of its pass: half their largest
+    fibre length times offset, and the face's own largest times their largest offset,
+    and the smoothing), times ``widening``. Returns (width, origin) (:func:`build_grid`).
+    Per pass, not over the table: a surface against itself reaches a few tenths of its
+    node spacing (``own_surface_limit``), against another surface the whole thickness,
+    and with the whole thickness every face of its own surface near a node had its
+    nearest point searched (on a near-closed valve, contact was 88% of the step)."""
     h = shape.h
-    deepest = widest = 0.0
+    passes = 0
     for m in range(loads.nodes.shape[0]):
-        deepest = max(deepest, loads.offset[m] * h[loads.nodes[m]])
-        widest = max(widest, loads.offset[m])
+        passes = max(passes, loads.group[m] + 1)
+    for f in range(loads.faces.shape[0]):
+        passes = max(passes, loads.face_group[f] + 1)
+    deepest, widest = np.zeros(passes), np.zeros(passes)
+    for m in range(loads.nodes.shape[0]):
+        g = loads.group[m]
+        deepest[g] = max(deepest[g], loads.offset[m] * h[loads.nodes[m]])
+        widest[g] = max(widest[g], loads.offset[m])
     for f in range(loads.faces.shape[0]):
         thickest = 0.0
         for a in range(9):
             thickest = max(thickest, h[loads.faces[f, a]])
-        loads.reach[f] = 0.5 * (deepest + widest * thickest) * (1.0 + TOUCHING) * widening
+        g = loads.face_group[f]
+        loads.reach[f] = 0.5 * (deepest[g] + widest[g] * thickest) * (1.0 + TOUCHING) * widening
     return build_grid(shape.x, loads.faces, loads.reach, (loads.boxes, loads.start, loads.entries))
 
 

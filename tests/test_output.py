@@ -736,3 +736,16 @@ def test_values_beyond_single_precision_are_written_as_infinities_without_a_warn
         warnings.simplefilter("error")
         stored = Encoding(np.float32).floats(np.array([1e300, -1e300, 1.5]))
     np.testing.assert_array_equal(stored, np.array([np.inf, -np.inf, 1.5], dtype=np.float32))
+
+
+def test_the_colour_bar_spans_the_finite_values_and_an_infinite_one_is_drawn_as_missing():
+    """A crushed element's infinite stress (a run that broke down) and a gap beyond the
+    search (NaN) are left out of the bar, which spans the other values over every frame
+    drawn; a flat field gets a scale around its value."""
+    from shellsim.output.render import _finite_or_missing, colour_limits
+
+    frames = [_finite_or_missing(np.array([0.2, np.inf, 0.5])), _finite_or_missing(np.array([np.nan, -np.inf, 0.1]))]
+    assert colour_limits(frames) == (0.1, 0.5)
+    assert np.isnan(frames[0][1]) and np.isnan(frames[1][1])
+    assert colour_limits([np.full(3, 2.0)]) == (1.0, 3.0)
+    assert colour_limits([np.full(2, np.nan)]) == (-0.5, 0.5)

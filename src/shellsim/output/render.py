@@ -185,6 +185,25 @@ class Drawn(NamedTuple):
 NO_OVERLAYS = Overlays()
 
 
+def _finite_or_missing(values: np.ndarray) -> np.ndarray:
+    """values with every infinity made NaN: missing, drawn grey, as a value that is not
+    there (a contact gap beyond the search) is; an element crushed in a run that then
+    broke down has an infinite stress, which would otherwise take the whole scale."""
+    return np.where(np.isfinite(values), values, np.nan)
+
+
+def colour_limits(fields: list[np.ndarray]) -> tuple[float, float]:
+    """The colour bar's (low, high) over the values of every frame drawn, NaN left out;
+    a flat field still gets a scale around its value, and none at all (0, 0) widened."""
+    low = min(float(np.nanmin(v, initial=np.inf)) for v in fields)
+    high = max(float(np.nanmax(v, initial=-np.inf)) for v in fields)
+    if not np.isfinite(low):
+        low = high = 0.0
+    if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
+        low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)
+    return low, high
+
+
 def render_field(folder: Path, field: str = "pressure_band", frame: str | int = "last", view: str = "iso",  # noqa: PLR0913 (the render command's options, each defaulted)
                  size: tuple[int, int] = (1200, 900), component: str | None = None,
                  out_dir: Path | None = None, overlays: Overlays = NO_OVERLAYS,
@@ -202,15 +221,9 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     indices = _frame_indices(frame, len(series.times))
     frames = [series.frame(i) for i in indices]
     title, units = _series_units(folder)
-    picked = [(units.scale(field) * values, on_cells, part)
+    picked = [(_finite_or_missing(units.scale(field) * values), on_cells, part)
               for values, on_cells, part in (field_values(p, c, field, component) for p, c in frames)]
-    # NaN marks a value that is not there (a contact gap beyond the search): drawn grey
-    low = min(float(np.nanmin(v, initial=np.inf)) for v, _, _ in picked)
-    high = max(float(np.nanmax(v, initial=-np.inf)) for v, _, _ in picked)
-    if not np.isfinite(low):
-        low = high = 0.0
-    if high - low <= 1e-12 * max(abs(low), abs(high), 1e-300):
-        low, high = low - 0.5 * max(abs(low), 1.0), high + 0.5 * max(abs(high), 1.0)  # a flat field still gets a scale
+    low, high = colour_limits([v for v, _, _ in picked])
     label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
     bar = units.label(f"{label} {picked[0][2]}".strip(), field)
     out_dir = output_folder(out_dir or refuse_link(folder / RENDERS_DIR))

@@ -261,26 +261,43 @@ def _recorded(residual, norms, eq):
     return residual
 
 
-def test_a_step_that_cannot_converge_is_stopped_with_where(tmp_path):
-    """A neo-Hookean tube (Test 9's) inflated far beyond its limit pressure, where no
-    equilibrium exists: load control cannot pass the limit point, so the steps are cut
-    back to the smallest and the run stops with exit code 3, the load time, the residual
-    and the node, the samples before it kept."""
+def burst_tube(tmp_path, solver: str, method: str = "static") -> tuple[int, str]:
+    """A neo-Hookean tube (Test 9's) inflated far beyond its limit pressure by ``method``,
+    its [solver] table's line after ``end_time`` given: the run's exit code and what it
+    said."""
     text = (ROOT / "decks" / "verification" / "test09_aorta_static.toml").read_text()
     text = re.sub(r"\[material\]\n[^\[]*\[[^\]]*\] }\n", '[material]\nmodel = "neo_hookean"\nC1 = 1.0e4\ndensity = 1050.0\n',
                   text)
-    text = text.replace("value = 18.66e3", "value = 10.0e3").replace(
-        'end_time = 0.16\n', 'end_time = 0.16\nstatic = { increments = 4, min_increment = 0.01, max_iterations = 10 }\n')
-    text = text[:text.index("[[reference]]")]
+    text = text.replace("value = 18.66e3", "value = 10.0e3").replace('end_time = 0.16\n', f'end_time = 0.16\n{solver}\n')
+    text = text[:text.index("[[reference]]")].replace('method = "static"', f'method = "{method}"')
     deck = tmp_path / "burst.toml"
     deck.write_text(text)
     result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet"])
-    assert result.exit_code == 3, result.output
-    said = " ".join(result.output.split())
-    assert "did not converge" in said and "% of solver.end_time" in said and "largest residual force is at node" in said
+    return result.exit_code, " ".join(result.output.split())
+
+
+def test_a_step_that_cannot_converge_is_stopped_with_where(tmp_path):
+    """The burst tube: no equilibrium exists past the limit pressure, so load control
+    cannot pass it, the steps are cut back to the smallest and the run stops with exit
+    code 3, the load time, the residual and the node, the samples before it kept."""
+    code, said = burst_tube(tmp_path, "static = { increments = 4, min_increment = 0.01, max_iterations = 10 }")
+    assert code == 3, said
+    assert "the static solve did not converge" in said and "% of solver.end_time" in said
+    assert "largest residual force is at node" in said
     assert "solver.static.control = \"arc_length\" follows the path over it" in said  # a limit point: load control stops
     history = (tmp_path / "out" / "history.csv").read_text().splitlines()
     assert len(history) >= 3  # the header, t = 0 and the steps before the limit point
+
+
+def test_an_implicit_step_that_cannot_converge_names_the_implicit_keys(tmp_path):
+    """The same tube solved implicitly with one Newton iteration a step allowed: its
+    steps are cut to the smallest and the message speaks of the implicit time step and
+    its own keys, not of load control's."""
+    code, said = burst_tube(tmp_path, "implicit = { increments = 4, min_increment = 0.01, max_iterations = 1 }",
+                            method="implicit")
+    assert code == 3, said
+    assert "the implicit time step did not converge" in said and "solver.implicit.min_increment" in said
+    assert "solver.static" not in said
 
 
 def _history(run, name: str) -> np.ndarray:

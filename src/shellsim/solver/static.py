@@ -384,16 +384,23 @@ def load_steps(run: Run, newton: NewtonSolver, listener: Listener, end: float) -
 LOAD_ADVICE = ("If the load has reached the most the structure carries on this path (a limit point, where "
                "more load steps stop at the same load), solver.static.control = \"arc_length\" follows the "
                "path over it; otherwise a smaller solver.static.min_increment, or the explicit method, may help")
+#: What may get an implicit time step past where it stopped.
+IMPLICIT_ADVICE = ("A smaller solver.implicit.min_increment, more numerical damping (solver.implicit.alpha "
+                   "toward -1/3), or the explicit method past this point may help")
 #: What may get an arc-length solve past where it stopped.
 ARC_ADVICE = ("More solver.static.increments (a shorter first arc) or the explicit method past this point "
               "may help")
 
 
-def not_converged(run: Run, newton: NewtonSolver, where: str, why: str, advice: str = LOAD_ADVICE) -> str:
+def not_converged(run: Run, newton: NewtonSolver, where: str, why: str, advice: str | None = None) -> str:
     """The message of a step that cannot be solved: ``where`` in the load, why, the node
-    with the largest residual force and its place, any folded element, and ``advice``."""
+    with the largest residual force and its place, any folded element, and ``advice``
+    (by default what may help load control, or an implicit run's time steps)."""
     s = run.sim.state
-    message = f"the static solve did not converge {where}: {why}"
+    implicit = run.deck.solver.method == "implicit"
+    if advice is None:
+        advice = IMPLICIT_ADVICE if implicit else LOAD_ADVICE
+    message = f"the {'implicit time step' if implicit else 'static solve'} did not converge {where}: {why}"
     local = newton.eq.unknowns.scatter(np.concatenate([newton.last_residual, np.zeros(newton.eq.unknowns.n_known)]))
     per_node = np.linalg.norm(local, axis=1)
     if per_node.max() > 0:

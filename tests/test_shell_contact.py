@@ -536,17 +536,17 @@ def test_a_face_s_search_box_is_grown_by_the_reach_of_its_own_pass(tmp_path):
                                                 "[mesh]\ndivisions = { length = 10, width = 2 }\n")))
         strip.x[:, 2] += level
         strips.append(strip)
-    n = strips[0].n_nodes
+    n, e = strips[0].n_nodes, strips[0].n_elements
     path = tmp_path / "strips.vtu"
     write_mesh_vtu(Mesh(x=np.vstack([s.x for s in strips]), conn=np.vstack([strips[0].conn, strips[1].conn + n]),
                         director=np.vstack([s.director for s in strips]), thickness=np.full(2 * n, 0.06),
-                        sets={"strips": NamedSet("surface", np.arange(2 * n), elements=np.arange(40))}), path)
+                        sets={"strips": NamedSet("surface", np.arange(2 * n), elements=np.arange(2 * e))}), path)
     deck = parse_deck(deck_text(f'builder = "file"\npath = "{path.as_posix()}"',
                                 '[[contact]]\ntype = "shells"\nname = "both"\nset = "strips"\n'))
     model = build_model(deck, build_mesh(deck))
     loads = model.loads.shell_contact
     _grid(initial_shape(model), loads, 1.0)
-    face_strip = loads.face_elements // 20
+    face_strip = loads.face_elements // e
     node_strip = {int(g): int(loads.nodes[loads.group == g][0] >= n) for g in np.unique(loads.group)}
     own = np.array([node_strip[int(g)] == s for g, s in zip(loads.face_group, face_strip)])
     assert own.any() and not own.all()

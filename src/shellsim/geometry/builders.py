@@ -413,10 +413,16 @@ def onto_valve(x: np.ndarray, conn: np.ndarray, g: AorticValve) -> tuple[np.ndar
     u, y = np.clip(x[:, 0] - 2.0 * k, 0.0, 1.0), np.clip(x[:, 1], 0.0, 1.0)
     mapped = valve_points(g, k, u, y)
     c = conn[:, 8]
+    return mapped, [], {"along_free_edge": along_free_edge(g, k[c], u[c], y[c])}
+
+
+def along_free_edge(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """(n, 3) the unit direction of growing u (commissure to commissure, where a leaflet's
+    collagen runs) on leaflet k (n,) at u, y (n,) (:func:`valve_points`), by central
+    differences within [0, 1]."""
     step = 1e-6
-    along = (valve_points(g, k[c], np.minimum(u[c] + step, 1.0), y[c])
-             - valve_points(g, k[c], np.maximum(u[c] - step, 0.0), y[c]))
-    return mapped, [], {"along_free_edge": along / np.linalg.norm(along, axis=1, keepdims=True)}
+    along = (valve_points(g, k, np.minimum(u + step, 1.0), y) - valve_points(g, k, np.maximum(u - step, 0.0), y))
+    return along / np.linalg.norm(along, axis=1, keepdims=True)
 
 
 

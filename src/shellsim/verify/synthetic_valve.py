@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from ..deck.geometry import AorticValve
-from ..geometry.builders import valve_points
+from ..geometry.builders import along_free_edge, valve_points
 
 #: The leaflets' shape: the aortic valve builder's, turned upside down [mm].
 SHAPE = AorticValve(builder="aortic_valve", commissure_radius=12.5, base_radius=15.0, height=12.0,
@@ -169,9 +169,7 @@ class SyntheticValve:
         u) at its centre, where the collagen runs."""
         i, j = (a.ravel() for a in np.mgrid[0:self.rows, 0:self.circumferential])
         u, y = self._parameters(i + 0.5, j + 0.5)
-        step = 1e-6
-        along = np.concatenate([_leaflet_points(g, u + step, y) - _leaflet_points(g, u - step, y) for g in range(3)])
-        return along / np.linalg.norm(along, axis=1, keepdims=True)
+        return np.concatenate([along_free_edge(SHAPE, np.full(len(u), g), u, y) for g in range(3)]) * [1.0, 1.0, -1.0]
 
     def annulus_motion(self) -> list[tuple[int, np.ndarray]]:
         """(label, displacement) of each attached node (the annulus and the commissure

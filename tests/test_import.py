@@ -652,3 +652,18 @@ def test_orientations_go_to_every_law_with_axes_and_are_listed_where_a_law_has_n
     model = read_foreign(path, law)
     assert "axes" not in model.tables["material"]
     assert any("is (0, 0, 0), which points nowhere" in line for line in model.unmapped), model.unmapped
+
+
+@pytest.mark.parametrize("keyword, throughout", [("*Variable Mass Scaling", True), ("*Fixed Mass Scaling", False)])
+def test_whole_model_mass_scaling_comes_over_held_throughout_when_variable(tmp_path, keyword, throughout):
+    """Mass scaling of the whole model to DT in an explicit step: variable scaling (applied
+    again through the step) as [solver.mass_scaling] throughout, fixed scaling (at the
+    step's start) as a scaling at the start only; each listed as one factor for every mass."""
+    text = strip_inp(extra_step=f"{keyword}, dt=2e-5, type=uniform, frequency=10").replace(
+        "*Static\n0.25, 1., 1e-05, 1.", "*Dynamic, Explicit\n, 1.")
+    (tmp_path / "strip.inp").write_text(text)
+    done = import_model(tmp_path / "strip.inp", tmp_path / "imported")
+    scaling = load_deck(done.deck).solver.mass_scaling
+    assert scaling.step == 2e-5 and scaling.throughout is throughout
+    said = next(line for line in done.unmapped if "MASS SCALING" in line.upper())
+    assert ("throughout = true" in said) is throughout and "one factor" in said

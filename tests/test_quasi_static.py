@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from shellsim.deck import load_deck, parse_deck
+from shellsim.deck.schema import MassScaling
 from shellsim.errors import DeckError
 from shellsim.solver.explicit import DAMPED, EXTERNAL
 
@@ -99,3 +100,59 @@ def test_a_static_run_refuses_what_only_an_explicit_run_has(key):
     text = (VERIFICATION / f"{CANTILEVER}_static.toml").read_text().replace('method = "static"', f'method = "static"\n{key}')
     with pytest.raises(DeckError, match=f"'{key.split()[0]}' is for explicit runs.*set method = 'explicit'"):
         parse_deck(text)
+
+
+SHEET = ROOT / "decks" / "stability" / "large_strain_sheet.toml"
+
+
+def test_mass_scaling_throughout_holds_the_step_while_the_sheet_stiffens():
+    """The Mooney-Rivlin sheet pulled to 3.3 times its length, whose step falls 2.45
+    times unscaled (the stability suite), every mass scaled throughout to twice its first
+    step: each later estimate that finds the step shorter scales the masses again, so the
+    run takes the target step (the estimates' margin below it at most) in about end_time /
+    target steps; the factor reaches at least 4 x 2^2; the thickness is the closed form's
+    h0 lambda^-1/2 and the energy balances, the kinetic energy kept at each rescaling."""
+    from shellsim.study.jobs import variant_deck
+
+    from .conftest import prepared
+
+    deck = load_deck(SHEET)
+    target = 2.0 * float(prepared(deck).sim.critical_time_step()) / deck.solver.dt_safety_factor
+    run = run_deck(variant_deck(SHEET, {"solver.mass_scaling": {"step": target, "throughout": True}}))
+    taken = np.array([dt for _, _, dt in run.dt_history])
+    assert run.mass_rescalings > 0 and run.sim.mass_factor > 4.0 * 2.0 ** 2
+    assert taken[1:].min() >= 0.95 * target
+    assert run.sim.state.steps <= 1.05 * run.deck.solver.end_time / target
+    stretch = 1.0 + 0.023 / 0.010
+    assert run.history["thickness"][-1] == pytest.approx(0.001 / np.sqrt(stretch), rel=1e-4)
+    assert abs(run.balance_error) < 1e-3 * run.sim.state.energy[EXTERNAL]
+
+
+def test_a_rescaling_keeps_the_kinetic_energy_and_the_springs_stiffness(tmp_path):
+    """Scaled again by hand (the step found at half the target): every mass times 4, the
+    velocities halved (the kinetic energy the same), the step the target exactly, and the
+    contact springs as they were (their rate and the masses they were set on together:
+    as stiff as before, so no energy enters those pressed)."""
+    from shellsim.solver.run import _hold_scaled_step
+
+    from .conftest import pressed_plates_deck, prepared
+
+    text = pressed_plates_deck(tmp_path / "plates.vtu", 0.01, "[solver]\nend_time = 1e-3\ndamping = 50.0")
+    run = prepared(parse_deck(text))
+    structure = float(run.sim.critical_time_step())
+    run.dt_critical = structure  # no other limit on these plates' step
+    run.dt = structure / run.deck.solver.dt_safety_factor
+    target = 2.0 * run.dt
+    run.deck = run.deck.model_copy(update={"solver": run.deck.solver.model_copy(
+        update={"mass_scaling": MassScaling(step=target, throughout=True)})})
+    s = run.sim.state
+    rng = np.random.default_rng(1)
+    s.v[...], s.w[...] = rng.standard_normal(s.v.shape), rng.standard_normal(s.w.shape)
+    kinetic = 0.5 * (s.mt @ (s.v ** 2).sum(axis=1) + s.mr @ (s.w ** 2).sum(axis=1))
+    contact = next(b for b in run.model.loads if b is not None and hasattr(b, "face_inverse_mass"))
+    spring, inverse_mass = contact.spring.copy(), contact.inverse_mass.copy()
+    _hold_scaled_step(run)
+    assert run.sim.mass_factor == pytest.approx(4.0, rel=1e-12) and run.mass_rescalings == 1
+    assert run.dt == pytest.approx(target, rel=1e-12) and run.dt_history[-1][2] == run.dt
+    assert 0.5 * (s.mt @ (s.v ** 2).sum(axis=1) + s.mr @ (s.w ** 2).sum(axis=1)) == pytest.approx(kinetic, rel=1e-12)
+    assert np.array_equal(contact.spring, spring) and np.array_equal(contact.inverse_mass, inverse_mass)

@@ -261,9 +261,18 @@ class MassScaling(Section):
     many times fewer steps to the end time. The factor and the mass added are reported
     (``mass_scaling`` in summary.json). Every period of the structure grows by the same
     factor as the step, so the loads must still come on slowly against the longest one,
-    and a mass-proportional ``damping`` acts (step / Δt) times more strongly on it."""
+    and a mass-proportional ``damping`` acts (step / Δt) times more strongly on it.
+
+    ``throughout``: also whenever a later estimate finds the step shorter than ``step``
+    (a stiffening tissue, an element thinning), every mass is scaled again to bring it
+    back, as Abaqus/Explicit's variable uniform mass scaling does; the velocities are
+    divided by the square root of that factor, which keeps the kinetic energy, and the
+    contact springs keep their stiffness. The factor reached and the count of such
+    rescalings are reported. A cable's own ``min_step`` holds its elements' steps apart
+    from this."""
 
     step: Positive
+    throughout: bool = False
 
 
 class Relaxation(Section):

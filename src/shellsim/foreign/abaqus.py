@@ -767,8 +767,8 @@ class _Builder:
         """``*VARIABLE`` or ``*FIXED MASS SCALING`` of the first step to a time step DT: on a
         set of line elements, its cables' ``min_step`` (each element made heavier until its
         own step is DT, as TYPE=BELOW MIN does); on shells or the whole model, the explicit
-        solve's uniform ``[solver.mass_scaling]`` (listed: every mass scaled by one factor,
-        not each element's by its own)."""
+        solve's uniform ``[solver.mass_scaling]``, held ``throughout`` the run for a variable
+        one (listed: every mass scaled by one factor, not each element's by its own)."""
         m = self.model
         for k in (k for k in (m.steps[0][1] if m.steps else []) if k.name in MASS_SCALING):
             step, elset, kind = k.param("dt"), k.param("elset"), (k.param("type") or "uniform").lower()
@@ -789,10 +789,12 @@ class _Builder:
             if self.tables["solver"].get("method") != "explicit":
                 m.unmapped.append(f"{k.label()}: mass scaling is for an explicit solve; not read")
                 continue
-            self.tables["solver"]["mass_scaling"] = {"step": float(step)}
+            variable = k.name == "variable mass scaling"
+            self.tables["solver"]["mass_scaling"] = {"step": float(step), **({"throughout": True} if variable else {})}
             m.unmapped.append(f"{k.label()}: {'ELSET=' + elset if elset else 'the whole model'}, TYPE="
-                              f"{kind.upper()}: brought over as [solver.mass_scaling] step = {float(step):g}, which "
-                              "scales every mass by one factor when the stable step is shorter")
+                              f"{kind.upper()}: brought over as [solver.mass_scaling] step = {float(step):g}"
+                              f"{', throughout = true' if variable else ''}, which scales every mass by one factor "
+                              f"when the stable step is shorter{' (again as it falls)' if variable else ''}")
 
 
 #: Keywords that scale masses for a longer explicit step.

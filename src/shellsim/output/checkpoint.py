@@ -46,7 +46,7 @@ PICKLED_NAME = "checkpoint.pkl"
 FORMAT = 2
 #: The run's record, saved as it is.
 RECORD = ("dt", "dt_critical", "dt_history", "times", "history", "energies", "wall_time", "startup", "ratios", "worst",
-          "lowest", "newton", "stepping")
+          "lowest", "newton", "stepping", "mass_rescalings")
 #: The only objects a checkpoint's record rebuilds, by name.
 RECORD_TYPES = {cls.__name__: cls for cls in (Worst, Stepping, EstimateSchedule, NewtonStep)}
 
@@ -71,6 +71,7 @@ SPECS = {
     "dt": float, "dt_critical": float, "wall_time": float, "dt_history": [(float, float, float)], "times": [float],
     "history": {str: [float]}, "energies": [np.ndarray], "startup": {str: float}, "ratios": Maybe(np.ndarray),
     "worst": Maybe(Worst), "lowest": Maybe(Worst), "newton": [NewtonStep], "stepping": Maybe(Stepping),
+    "mass_rescalings": int,
     Worst: {"t": float, "element": int, "ratio": float},
     NewtonStep: {"t": float, "load_time": float, "iterations": int, "tangents": int, "residual": float,
                  "cutbacks": int},

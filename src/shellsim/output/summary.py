@@ -82,7 +82,8 @@ def summary(run: Run, deck_path: Path, plan: Plan, message: str | None = None, o
         **({"implicit": static_record(run)} if run.deck.solver.method == "implicit" else {}),
         **{measure.NAME: entry for measure in run.measures
            if (entry := measure.record(run, output_seconds)) is not None},
-        **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0)}}
+        **({"mass_scaling": {"factor": run.sim.mass_factor, "added_mass_percent": 100.0 * (run.sim.mass_factor - 1.0),
+                             "rescalings": run.mass_rescalings}}
            if run.deck.solver.mass_scaling is not None else {}),
         **({"relaxation": run.relaxing.record(run.sim)} if run.relaxing is not None else {}),
         **({"unloaded_shape": run.unloading.record()} if run.unloading is not None else {}),

@@ -83,6 +83,7 @@ class Run:
     relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
     unloading: object | None = None  # finding an imaged scene's unloaded shape (unloaded.Unloading)
     stepping: Stepping | None = None  # the time loop's place between step estimates, once it has begun
+    mass_rescalings: int = 0  # the masses scaled again during the run (mass scaling throughout)
 
     @property
     def load_time(self) -> float:
@@ -271,6 +272,40 @@ def _update_time_step(run: Run, listener: Listener) -> float:
     return structure
 
 
+def _unscaled_critical(run: Run) -> float:
+    """The critical step of the structure's own masses: how fast it changes tells when to
+    estimate it again, which a rescaling of the masses (mass scaling throughout) does not."""
+    return run.dt_critical / math.sqrt(run.sim.mass_factor)
+
+
+def _hold_scaled_step(run: Run) -> None:
+    """Mass scaling throughout: a later estimate's step ``run.dt`` shorter than the deck's
+    target is brought back to it, every mass times (target / step)^2 (within
+    MOST_MASS_FACTOR in all). A uniform factor multiplies every period alike, so the
+    critical step follows exactly, without another estimate (a second entry in the step
+    history at the same time); the velocities are divided by the factor's square root,
+    which keeps the kinetic energy, so nothing enters the balance. The penalty springs keep
+    the stiffness they were set to (their rate s / dt^2 and the masses they were set on
+    stay together): set again on a stiffer structure's step they would store energy from
+    nowhere wherever they are pressed, and on heavier nodes they stay stable."""
+    scaling = run.deck.solver.mass_scaling
+    if scaling is None or not scaling.throughout or run.dt >= scaling.step:
+        return
+    factor = min((scaling.step / run.dt) ** 2, MOST_MASS_FACTOR / run.sim.mass_factor)
+    if factor <= 1.0:
+        return
+    sim, s = run.sim, run.sim.state
+    sim.mass_factor *= factor
+    for mass in (s.mt, s.mr):
+        mass *= factor
+    for velocity in (s.v, s.w):
+        velocity /= math.sqrt(factor)
+    run.dt_critical *= math.sqrt(factor)
+    run.dt = time_step(run.deck.solver, run.dt_critical)
+    run.dt_history.append((s.t, run.dt_critical, run.dt))
+    run.mass_rescalings += 1
+
+
 #: Mass scaling beyond this factor (a step a thousand times the stable one) is refused:
 #: the run would follow the dynamics of another, far heavier structure.
 MOST_MASS_FACTOR = 1e6
@@ -388,7 +423,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                 take_sample(run, listener)
                 take_frame(run, listener)
             schedule = EstimateSchedule(solver.dt_safety_factor, solver.dt_update_every)
-            run.stepping = Stepping(schedule, schedule.after_estimate(sim.state.steps, run.dt_critical))
+            run.stepping = Stepping(schedule, schedule.after_estimate(sim.state.steps, _unscaled_critical(run)))
         stepping = run.stepping
         history_interval = solver.end_time / HISTORY_SAMPLES
         landings = output_times(run.deck)
@@ -403,7 +438,8 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                     stepping.since_update += steps
                     if stepping.since_update >= stepping.interval:
                         _update_time_step(run, listener)
-                        stepping.interval = stepping.schedule.after_estimate(sim.state.steps, run.dt_critical)
+                        _hold_scaled_step(run)
+                        stepping.interval = stepping.schedule.after_estimate(sim.state.steps, _unscaled_critical(run))
                         stepping.since_update = 0
                         break  # re-plan the steps with the new dt
                 take_sample(run, listener)

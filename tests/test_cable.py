@@ -256,6 +256,35 @@ def test_min_step_makes_only_the_cable_s_quicker_elements_heavier_to_it():
     assert "mu=[200000, 50000, -100000], alpha=[8, 3, -2]" in ogden.cable[0].summary
 
 
+def test_min_step_is_held_as_the_cable_stiffens():
+    """A chord of a stiffening (exponential) law made heavier at rest to its min_step:
+    stretched 30% its elements' own step falls below it, and holding it makes them heavier
+    again until each is min_step (the cables' step is then min_step); back at rest they
+    are not made lighter, and an element already slower is left alone."""
+    from shellsim.bundles import Shape
+    from shellsim.deck import parse_deck
+    from shellsim.geometry import build_mesh
+    from shellsim.loads.cable import _own_step, critical_step, hold_min_step
+    from shellsim.model import build_model
+
+    deck = parse_deck(deck_text(PLATE, ANCHOR + cable_table('{ model = "exponential", a = 1.0e5, b = 5.0 }',
+                                                              (2.0, 0.5, 0.0), 4, "min_step = 0.02")))
+    model = build_model(deck, build_mesh(deck))
+    cables = model.loads.cable
+    rest = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
+    stretched = rest._replace(x=1.3 * model.x0)
+    assert critical_step(rest, cables) == pytest.approx(0.02, rel=1e-12)
+    assert critical_step(stretched, cables) < 0.9 * 0.02
+    at_rest = cables.density.copy()
+    hold_min_step(stretched, cables)
+    assert np.all(cables.density > at_rest)
+    e = np.empty(3)
+    np.testing.assert_allclose([_own_step(stretched.x, cables, k, e) for k in range(len(at_rest))], 0.02, rtol=1e-12)
+    held = cables.density.copy()
+    hold_min_step(rest, cables)
+    np.testing.assert_array_equal(cables.density, held)
+
+
 def test_the_cable_tangent_is_the_derivative_of_its_forces():
     """The couplings' blocks of a stretched, turned cable against central differences of
     its forces (the exact tangent, to the differences' truncation)."""

@@ -220,6 +220,13 @@ def stable_step(model, shape: Shape, structure: float, mass_factor: float = 1.0)
     return min([structure * step_share(model)] + own)
 
 
+def hold_min_steps(model, shape: Shape) -> None:
+    """Every load kind's own elements (cables) whose critical step on ``shape`` has fallen
+    below their ``min_step`` made heavier to it, in place (before :func:`add_masses`)."""
+    for kind, bundle in _with(model, "hold_min_step"):
+        kind.hold_min_step(shape, bundle)
+
+
 def add_masses(model, mt: np.ndarray, rotary: np.ndarray) -> None:
     """The masses of every load kind's own elements (cables) added to the shell's lumped
     masses mt and rotary masses (n,), in place."""

@@ -46,9 +46,10 @@ class Cable(LoadTable):
     chords' masses). Its strain energy counts as work of external forces. A static solve
     (or preload) takes one segment per chord, and a free tip needs holding across the
     chords (a string at rest has no lateral stiffness). ``min_step`` [time]: each element
-    whose own critical step at rest is shorter is made heavier until it is this (Abaqus'
-    ``*VARIABLE MASS SCALING, TYPE=BELOW MIN`` on the set, done once at the start): a
-    chord's short stiff segments then no longer set an explicit run's step."""
+    whose own critical step is shorter is made heavier until it is this, at the start and
+    again at each later step estimate as it stiffens (never lighter: Abaqus'
+    ``*VARIABLE MASS SCALING, TYPE=BELOW MIN`` on the set): a chord's short stiff segments
+    then no longer set an explicit run's step, however far they stretch."""
 
     type: Literal["cable"] = "cable"
     name: Name
@@ -167,13 +168,15 @@ def extend_mesh(table: Cable, mesh: Mesh) -> Mesh:
 
 class Bundle(NamedTuple):
     """Cable elements (L): nodes (L, 2) their ends; rest (L,) rest lengths [length];
-    area (L,) initial cross-sections [length^2]; density (L,) [mass/length^3]; law (L,)
-    and params (L, PARAMETERS) of :mod:`.cable_laws`; gravity (L, 3) [length/time^2]."""
+    area (L,) initial cross-sections [length^2]; density (L,) [mass/length^3], raised in
+    place to hold ``min_step`` (L,) [time] (0: none); law (L,) and params (L, PARAMETERS)
+    of :mod:`.cable_laws`; gravity (L, 3) [length/time^2]."""
 
     nodes: np.ndarray
     rest: np.ndarray
     area: np.ndarray
     density: np.ndarray
+    min_step: np.ndarray
     law: np.ndarray
     params: np.ndarray
     gravity: np.ndarray
@@ -192,8 +195,8 @@ def build(table: Cable, scene) -> Bundle:
         own_step = rest * np.sqrt(table.density / nominal_stress(code, params, 1.0)[1])
         density *= np.maximum(1.0, (table.min_step / own_step) ** 2)
     return Bundle(nodes=nodes, rest=rest, area=np.full(count, table.area), density=density,
-                  law=np.full(count, code, dtype=np.int64), params=np.tile(params, (count, 1)),
-                  gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
+                  min_step=np.full(count, table.min_step or 0.0), law=np.full(count, code, dtype=np.int64),
+                  params=np.tile(params, (count, 1)), gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
 
 
 @njit(cache=True, inline="always")
@@ -275,19 +278,36 @@ def add_masses(cables: Bundle, mt: np.ndarray, mr: np.ndarray) -> None:
 
 
 @njit(cache=True)
+def _own_step(x, cables, k, e):
+    """Element k's critical step on its own lumped mass, sqrt(m / k) with m = rho A L and k
+    the larger of the axial and lateral stiffness, the law's slope taken at a stretch of
+    at least 1 (a slack element stiffens as soon as it is taut); +inf without stiffness."""
+    tension, length, stretch, dp = _tension(x, cables, k, e)
+    if stretch < 1.0:  # slack: the slope it takes up as soon as it is taut
+        dp = nominal_stress(cables.law[k], cables.params[k], 1.0)[1]
+    stiffness = max(cables.area[k] * dp / cables.rest[k], tension / length)
+    if stiffness <= 0.0:
+        return np.inf
+    return np.sqrt(cables.density[k] * cables.area[k] * cables.rest[k] / stiffness)
+
+
+@njit(cache=True)
 def critical_step(shape, cables):
-    """The smallest critical step of the elements on their own lumped masses, sqrt(m / k)
-    with m = rho A L and k the larger of the axial and lateral stiffness, the law's slope
-    taken at a stretch of at least 1 (a slack element stiffens as soon as it is taut);
-    +inf for none."""
+    """The smallest of the elements' own critical steps (:func:`_own_step`); +inf for none."""
     e = np.empty(3)
     smallest = np.inf
     for k in range(cables.nodes.shape[0]):
-        tension, length, stretch, dp = _tension(shape.x, cables, k, e)
-        if stretch < 1.0:  # slack: the slope it takes up as soon as it is taut
-            dp = nominal_stress(cables.law[k], cables.params[k], 1.0)[1]
-        stiffness = max(cables.area[k] * dp / cables.rest[k], tension / length)
-        if stiffness > 0.0:
-            mass = cables.density[k] * cables.area[k] * cables.rest[k]
-            smallest = min(smallest, np.sqrt(mass / stiffness))
+        smallest = min(smallest, _own_step(shape.x, cables, k, e))
     return smallest
+
+
+@njit(cache=True)
+def hold_min_step(shape, cables):
+    """Each element whose own critical step on ``shape`` is below its ``min_step`` made
+    heavier until it is that (its density raised in place, never lowered)."""
+    e = np.empty(3)
+    for k in range(cables.nodes.shape[0]):
+        if cables.min_step[k] > 0.0:
+            own = _own_step(shape.x, cables, k, e)
+            if own < cables.min_step[k]:
+                cables.density[k] *= (cables.min_step[k] / own) ** 2

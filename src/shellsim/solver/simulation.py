@@ -19,7 +19,7 @@ from ..element.static_loop import ElementLoop
 from ..compiled_call import TypedCall
 from ..compile_beside import CompiledBeside
 from ..errors import NumericalError
-from ..loads import add_masses
+from ..loads import add_masses, hold_min_steps
 from ..model import Model
 from ..threads import ThreadChooser, kernel_threads, limit_to_usable_cpus
 from . import explicit
@@ -93,9 +93,10 @@ class Simulation:
 
     def update_masses(self) -> None:
         """Lumped masses on the current configuration (M1 or M2, thesis 3.14), the cables'
-        added, all times ``mass_factor``."""
+        added (those below their min_step made heavier first), all times ``mass_factor``."""
         m, s = self.model, self.state
         self.compiled.masses(m.rule, m.body, s.fields.shape, m.body.density, m.mass == "M1", s.mt, s.mr)
+        hold_min_steps(m, s.fields.shape)
         add_masses(m, s.mt, s.mr)
         if self.mass_factor != 1.0:
             s.mt *= self.mass_factor

@@ -156,3 +156,29 @@ def test_a_rescaling_keeps_the_kinetic_energy_and_the_springs_stiffness(tmp_path
     assert run.dt == pytest.approx(target, rel=1e-12) and run.dt_history[-1][2] == run.dt
     assert 0.5 * (s.mt @ (s.v ** 2).sum(axis=1) + s.mr @ (s.w ** 2).sum(axis=1)) == pytest.approx(kinetic, rel=1e-12)
     assert np.array_equal(contact.spring, spring) and np.array_equal(contact.inverse_mass, inverse_mass)
+
+
+def test_a_rescaling_keeps_the_supports_speeds_and_counts_their_work():
+    """The sheet's pulled edge (prescribed translations) scaled again by 4: its imposed
+    speeds stay (the supports keep them), the free DOFs' are halved, and the kinetic
+    energy the supports give the added mass, 3/8 m v^2 on the unscaled masses, is their
+    work."""
+    from shellsim.solver.run import _hold_scaled_step
+
+    from .conftest import prepared
+
+    deck = load_deck(SHEET)
+    run = prepared(deck.model_copy(update={"solver": deck.solver.model_copy(
+        update={"mass_scaling": MassScaling(step=1.0, throughout=True)})}))
+    run.dt_critical, run.dt = 0.625, 0.5  # half the target: every mass times 4
+    s = run.sim.state
+    prescribed = run.model.constraints.prescribed
+    s.v[...] = np.random.default_rng(2).standard_normal(s.v.shape)
+    imposed, mass = s.v[prescribed.nodes, prescribed.axes].copy(), s.mt[prescribed.nodes].copy()
+    free = np.ones(s.v.shape, dtype=bool)
+    free[prescribed.nodes, prescribed.axes] = False
+    before, work = s.v[free].copy(), float(s.work[EXTERNAL])
+    _hold_scaled_step(run)
+    assert len(imposed) > 0 and np.array_equal(s.v[prescribed.nodes, prescribed.axes], imposed)
+    np.testing.assert_allclose(s.v[free], before / 2.0, rtol=1e-15)
+    assert s.work[EXTERNAL] - work == pytest.approx(0.5 * 3.0 * float(mass @ imposed ** 2), rel=1e-12)

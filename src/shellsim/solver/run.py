@@ -284,7 +284,9 @@ def _hold_scaled_step(run: Run) -> None:
     MOST_MASS_FACTOR in all). A uniform factor multiplies every period alike, so the
     critical step follows exactly, without another estimate (a second entry in the step
     history at the same time); the velocities are divided by the factor's square root,
-    which keeps the kinetic energy, so nothing enters the balance. The penalty springs keep
+    which keeps the kinetic energy, so nothing enters the balance, but for those of
+    prescribed translations, which the supports keep (the energy that brings the added
+    mass to their speed counted as their work). The penalty springs keep
     the stiffness they were set to (their rate s / dt^2 and the masses they were set on
     stay together): set again on a stiffer structure's step they would store energy from
     nowhere wherever they are pressed, and on heavier nodes they stay stable."""
@@ -298,8 +300,13 @@ def _hold_scaled_step(run: Run) -> None:
     sim.mass_factor *= factor
     for mass in (s.mt, s.mr):
         mass *= factor
+    prescribed = run.model.constraints.prescribed
+    imposed = s.v[prescribed.nodes, prescribed.axes]  # the supports' speeds, kept
     for velocity in (s.v, s.w):
         velocity /= math.sqrt(factor)
+    s.v[prescribed.nodes, prescribed.axes] = imposed
+    # a support brings its node's added mass up to its own speed: that kinetic energy is its work
+    s.work[EXTERNAL] += 0.5 * (1.0 - 1.0 / factor) * float(s.mt[prescribed.nodes] @ imposed ** 2)
     run.dt_critical *= math.sqrt(factor)
     run.dt = time_step(run.deck.solver, run.dt_critical)
     run.dt_history.append((s.t, run.dt_critical, run.dt))

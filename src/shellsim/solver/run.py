@@ -286,10 +286,10 @@ def _hold_scaled_step(run: Run) -> None:
     history at the same time); the velocities are divided by the factor's square root,
     which keeps the kinetic energy, so nothing enters the balance, but for those of
     prescribed translations, which the supports keep (the energy that brings the added
-    mass to their speed counted as their work). The penalty springs keep
-    the stiffness they were set to (their rate s / dt^2 and the masses they were set on
-    stay together): set again on a stiffer structure's step they would store energy from
-    nowhere wherever they are pressed, and on heavier nodes they stay stable."""
+    mass to their speed counted as their work). The penalty springs keep the stiffness
+    they were set to (their rate s / dt^2 and the masses they were set on stay together):
+    set again on a stiffer structure's step they would store energy from nowhere wherever
+    they are pressed, and on heavier nodes they stay stable."""
     scaling = run.deck.solver.mass_scaling
     if scaling is None or not scaling.throughout or run.dt >= scaling.step:
         return

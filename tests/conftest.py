@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -199,3 +200,21 @@ def cylinder_stl(path: Path, radius: float, length: float, around: int = 128, al
     from shellsim.verify.surfaces import tube_facets, write_facets
 
     return write_facets(path, *tube_facets(radius, radius, length, around, along))
+
+
+@pytest.fixture
+def ctrl_c_delivered():
+    """Ctrl-C raising KeyboardInterrupt in this process for the test, and the default
+    action in the processes it starts, however the suite was started and whatever ran
+    before in its worker: a shell starting it in the background (``make test &``) has it
+    ignored, and children inherit that (and a blocked signal)."""
+
+    def in_the_child() -> None:  # a child's preexec_fn
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    yield in_the_child
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+    signal.signal(signal.SIGINT, previous)

@@ -253,7 +253,7 @@ def test_a_static_summary_states_the_load_reached_and_the_largest_on_the_way():
     assert record["largest_load_factors"] == {"load_factor_ramp": 0.3}
 
 
-def test_a_stop_while_the_meshing_child_is_forked_is_not_lost():
+def test_a_stop_while_the_meshing_child_is_forked_is_not_lost(ctrl_c_delivered):
     """Ctrl-C arriving inside the fork's own hooks (as one did in the logging module's,
     where it was printed as ignored and lost, and the meshing ran on): the child is
     killed and the interrupt raised once the fork is done, not half a minute later."""

@@ -422,16 +422,6 @@ def _wait_for_frames(path: Path, count: int, process: subprocess.Popen, limit: f
     raise AssertionError(f"no {count} frames in {path} after {limit} s")
 
 
-@pytest.fixture
-def ctrl_c_delivered():
-    """Ctrl-C raising KeyboardInterrupt in this process for the test, and the default
-    action in the processes it starts, however the suite was started: a shell starting
-    it in the background (``make test &``) has it ignored, and children inherit that."""
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    yield lambda: signal.signal(signal.SIGINT, signal.SIG_DFL)  # a child's preexec_fn
-    signal.signal(signal.SIGINT, previous)
-
-
 @pytest.mark.parametrize(("stop", "code"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["ctrl-c", "sigterm"])
 def test_a_stopped_run_leaves_a_readable_series_and_a_summary_marked_interrupted(tmp_path, stop, code,
                                                                                 ctrl_c_delivered):

@@ -121,7 +121,7 @@ def test_a_size_in_the_wrong_units_is_refused_before_meshing_with_a_size_to_use(
 
 @pytest.mark.parametrize(("stop", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
                                                      (signal.SIGTERM, 143, "terminated")])
-def test_a_stop_ends_gmsh_meshing_at_once(tmp_path, stop, code, word):
+def test_a_stop_ends_gmsh_meshing_at_once(tmp_path, stop, code, word, ctrl_c_delivered):
     """`shellsim mesh` of the carotid at 0.06 mm (about 400,000 elements: minutes of gmsh)
     stopped by Ctrl-C or SIGTERM a second after it says it is meshing: it exits with 130
     or 143 and says so, within a minute (gmsh ran on, deaf to both, until it was done)."""
@@ -129,7 +129,7 @@ def test_a_stop_ends_gmsh_meshing_at_once(tmp_path, stop, code, word):
     deck.write_text(DECK.format(path=(ROOT / "decks" / "tissue" / "carotid_segment.stl").as_posix()))
     process = subprocess.Popen([sys.executable, "-m", "shellsim", "mesh", str(deck), "--out", str(tmp_path / "out")],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                               env=os.environ | {"COLUMNS": "200"})
+                               env=os.environ | {"COLUMNS": "200"}, preexec_fn=ctrl_c_delivered)
     said = ""
     while "meshing" not in said and select.select([process.stderr], [], [], 120.0)[0]:
         said = process.stderr.readline()

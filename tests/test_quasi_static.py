@@ -161,8 +161,8 @@ def test_a_rescaling_keeps_the_kinetic_energy_and_the_springs_stiffness(tmp_path
 def test_a_rescaling_keeps_the_supports_speeds_and_counts_their_work():
     """The sheet's pulled edge (prescribed translations) scaled again by 4: its imposed
     speeds stay (the supports keep them), the free DOFs' are halved, and the kinetic
-    energy the supports give the added mass, 3/8 m v^2 on the unscaled masses, is their
-    work."""
+    energy the supports give the added mass, (4 - 1) m v^2 / 2 on the unscaled masses,
+    is their work."""
     from shellsim.solver.run import _hold_scaled_step
 
     from .conftest import prepared

@@ -105,6 +105,12 @@ def test_a_static_run_refuses_what_only_an_explicit_run_has(key):
 SHEET = ROOT / "decks" / "stability" / "large_strain_sheet.toml"
 
 
+def _scaled_throughout(deck, step: float):
+    """``deck`` with every mass scaled throughout to ``step``."""
+    return deck.model_copy(update={"solver": deck.solver.model_copy(
+        update={"mass_scaling": MassScaling(step=step, throughout=True)})})
+
+
 def test_mass_scaling_throughout_holds_the_step_while_the_sheet_stiffens():
     """The Mooney-Rivlin sheet pulled to 3.3 times its length, whose step falls 2.45
     times unscaled (the stability suite), every mass scaled throughout to twice its first
@@ -143,8 +149,7 @@ def test_a_rescaling_keeps_the_kinetic_energy_and_the_springs_stiffness(tmp_path
     run.dt_critical = structure  # no other limit on these plates' step
     run.dt = structure / run.deck.solver.dt_safety_factor
     target = 2.0 * run.dt
-    run.deck = run.deck.model_copy(update={"solver": run.deck.solver.model_copy(
-        update={"mass_scaling": MassScaling(step=target, throughout=True)})})
+    run.deck = _scaled_throughout(run.deck, target)
     s = run.sim.state
     rng = np.random.default_rng(1)
     s.v[...], s.w[...] = rng.standard_normal(s.v.shape), rng.standard_normal(s.w.shape)
@@ -168,8 +173,7 @@ def test_a_rescaling_keeps_the_supports_speeds_and_counts_their_work():
     from .conftest import prepared
 
     deck = load_deck(SHEET)
-    run = prepared(deck.model_copy(update={"solver": deck.solver.model_copy(
-        update={"mass_scaling": MassScaling(step=1.0, throughout=True)})}))
+    run = prepared(_scaled_throughout(deck, 1.0))
     run.dt_critical, run.dt = 0.625, 0.5  # half the target: every mass times 4
     s = run.sim.state
     prescribed = run.model.constraints.prescribed

@@ -190,13 +190,11 @@ def build(table: Cable, scene) -> Bundle:
     count = len(nodes)
     code, params = code_and_parameters(table.law)
     rest = table.rest_length * np.linalg.norm(mesh.x[nodes[:, 1]] - mesh.x[nodes[:, 0]], axis=1)
-    density = np.full(count, table.density)
-    if table.min_step is not None:  # sqrt(rho A L / (A P'(1) / L)) = L sqrt(rho / P'(1)) made min_step
-        own_step = rest * np.sqrt(table.density / nominal_stress(code, params, 1.0)[1])
-        density *= np.maximum(1.0, (table.min_step / own_step) ** 2)
-    return Bundle(nodes=nodes, rest=rest, area=np.full(count, table.area), density=density,
-                  min_step=np.full(count, table.min_step or 0.0), law=np.full(count, code, dtype=np.int64),
-                  params=np.tile(params, (count, 1)), gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
+    bundle = Bundle(nodes=nodes, rest=rest, area=np.full(count, table.area), density=np.full(count, table.density),
+                    min_step=np.full(count, table.min_step or 0.0), law=np.full(count, code, dtype=np.int64),
+                    params=np.tile(params, (count, 1)), gravity=np.tile(np.asarray(table.gravity, dtype=float), (count, 1)))
+    hold_min_step(scene.initial, bundle)  # the elements quicker than min_step at the start made heavier
+    return bundle
 
 
 @njit(cache=True, inline="always")

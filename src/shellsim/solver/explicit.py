@@ -259,8 +259,9 @@ def advance(response, t, t_stop, max_steps, dt, dt_prev, model, fields, space, f
             node, i = prescribed.nodes[p], prescribed.axes[p]
             target = model.x0[node, i] + prescribed.values[p] * factor(model.curves, prescribed.curves[p], t + step)
             v_new = (target - x[node, i]) / step
-            # the support's reaction (inertia less applied forces) works on the motion
-            reaction = (mt[node] * (v_new - prescribed_velocity[p]) / dt_avg
+            # the support's reaction (inertia and the damping force it holds off, less the
+            # applied forces) works on the motion: it pays the damping work counted there
+            reaction = (mt[node] * (v_new - prescribed_velocity[p]) / dt_avg + damping * mt[node] * v_new
                         - (f_ext[node, i] - f_int[node, i]))
             work_ext += reaction * v_new * step
             kinetic += 0.5 * mt[node] * (prescribed_velocity[p] * v_new - v[node, i] * v[node, i])

@@ -246,6 +246,7 @@ def test_the_supports_pay_the_damping_of_the_motion_they_prescribe():
     sheet = (ROOT / "decks" / "stability" / "large_strain_sheet.toml").read_text()
     text = (sheet.replace('set = "x1"\ntranslation = "x"\nvalue = 0.023', 'set = "all"\ntranslation = "z"\nvalue = 0.005')
             .replace("end_time = 0.25", "end_time = 0.05").replace("t = [0.0, 0.2]", "t = [0.0, 0.05]"))
+    assert 'set = "all"' in text and "end_time = 0.05" in text and "t = [0.0, 0.05]" in text
     run = run_deck(parse_deck(text))
     e = run.sim.state.energy
     assert e[DAMPED] > 0.1 * e[EXTERNAL] > 0.0  # the damping takes a good share

@@ -1,7 +1,8 @@
 """Valve measures against what they must read: the area and widest opening of a square
 hole in a plate, the opening between the aortic valve builder's leaflets (set by their
 thickness, as a solid's shadow), the coaptation of two plates pressed together, the
-peak principal stress of a strip in uniaxial tension; the deck table's names checked."""
+peak principal stress of a strip in uniaxial tension and of a cantilever's bending away
+from its clamp; the deck table's names checked."""
 
 from __future__ import annotations
 
@@ -121,6 +122,36 @@ annulus = "x1"
     measures = run.measure("valve")(run.sim)
     assert measures["peak_principal_stress"] == pytest.approx(s, rel=1e-4)
     assert measures["orifice_area"] == 0.0
+
+
+def test_a_cantilever_s_peak_stress_away_from_its_clamp_is_the_beam_s_there():
+    """A 2 x 1 strip (4 x 2 elements, h = 0.01, nu = 0) clamped along x = 0, its annulus,
+    bent by an edge force q across its free end: the bending stress is 12 q (L - x) z / h^3
+    (a beam: with nu = 0 the clamp holds no anticlastic curvature back). Its peak is at the
+    points nearest the clamp; clear of the annulus by half its radius (the mean distance of
+    its nodes from their centre, 0.3), at the first in-plane points past 0.15, x = 0.25,
+    each element's middle row, in the outermost thickness layer."""
+    q, h, length = 1e-6, 0.01, 2.0
+    deck = parse_deck(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', f'''
+[mesh]
+divisions = {{ length = 4, width = 2 }}
+[[boundary]]
+type = "clamped"
+set = "x0"
+[[load]]
+type = "edge_force"
+set = "x1"
+value = [0.0, 0.0, {q}]
+[output.valve]
+annulus = "x0"
+stress_clearance = 0.5
+''').replace("nu = 0.3", "nu = 0.0").replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0'))
+    run = run_deck(deck)
+    outermost = np.abs(run.model.rule.tz).max() * h / 2.0
+    measures = run.measure("valve")(run.sim)
+    assert measures["peak_principal_stress_away"] == pytest.approx(12.0 * q * (length - 0.25) * outermost / h**3, rel=1e-3)
+    gauss = 0.25 * (1.0 - math.sqrt(0.6))  # the points nearest the clamp
+    assert measures["peak_principal_stress"] == pytest.approx(12.0 * q * (length - gauss) * outermost / h**3, rel=1e-3)
 
 
 @pytest.mark.parametrize("table, expected", [

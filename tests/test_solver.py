@@ -94,8 +94,10 @@ def test_a_critical_step_estimate_over_budget_errs_on_the_safe_side(monkeypatch)
 
 
 def test_a_degenerate_operator_is_a_message_not_an_arpack_error():
-    """No stiffness at all (every product zero: ARPACK cannot start) and masses that are no
-    number each end in NumericalError saying what is degenerate and what to check."""
+    """No stiffness at all (every product zero: ARPACK cannot start), a stiffness that is
+    no number (a shape degenerated in a run: it was a traceback from the Lanczos
+    iteration's tridiagonal solver) and masses that are no number each end in
+    NumericalError saying what is degenerate and what to check."""
     from shellsim.solver import timestep
 
     sim = prepared(parse_deck(PLATE.read_text())).sim
@@ -104,6 +106,10 @@ def test_a_degenerate_operator_is_a_message_not_an_arpack_error():
     sim.compiled = zero
     with pytest.raises(NumericalError, match=r"could not be estimated at t = 0: .*check the magnitudes of material.E"):
         timestep.largest_eigenvalue(sim)
+    sim.compiled = zero._replace(stiffness=lambda *args: [a.fill(np.nan) for a in args[5:7]])
+    for start in (None, np.ones(5 * len(sim.state.mt))):  # ARPACK's first estimate, and a later one's Lanczos
+        with pytest.raises(NumericalError, match=r"broke down at t = 0: the stiffness at its shape is no longer a number"):
+            timestep.largest_eigenvalue(sim, start)
     sim.state.mt[3] = np.nan
     with pytest.raises(NumericalError, match=r"lumped masses of 1 nodes \(first, counting from 1: \[4\]\)"):
         timestep.largest_eigenvalue(sim)

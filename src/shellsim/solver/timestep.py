@@ -137,7 +137,11 @@ def largest_eigenvalue(sim, start: np.ndarray | None = None,
         sim.compiled.stiffness(m.structure, s.fields.shape, s.stress, vu, vr, fu, fr, space.parts)
         out_u = np.einsum("nij,nj->ni", projector, fu) * inv_sqrt_t[:, None]
         out_r = fr * rot_free * inv_sqrt_r[:, None]
-        return np.concatenate([out_u.ravel(), out_r.ravel()])
+        product = np.concatenate([out_u.ravel(), out_r.ravel()])
+        if not np.isfinite(product).all():  # the shape has degenerated (a crushed element): no step exists
+            raise NumericalError(f"the run broke down at t = {s.t:.6g}: the stiffness at its shape is no longer "
+                                 "a number, so no critical time step exists; the motion had become unstable")
+        return product
 
     size = 5 * n
     if start is not None:

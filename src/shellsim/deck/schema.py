@@ -320,7 +320,11 @@ class Solver(Section):
     inverse), Δt_critical re-estimated at least every ``dt_update_every`` steps, and more
     often while it moves: each interval is as long as keeps its change, at the fastest rate
     seen over the last ``dt_update_every`` steps, within a quarter of the margin the safety
-    factor leaves (5 steps to the first, each at most twice the one before). ``mass``: lumped M1
+    factor leaves (5 steps to the first, each at most twice the one before), and at most
+    ``dt_max`` (no limit by default): a scene that stiffens as it deforms (soft leaflets
+    pressed shut) may need a step well below its step at rest, and contact's penalty
+    springs are then set on the critical step that step stands for (``dt_max`` x
+    ``dt_safety_factor`` / the penalties' share), stiffer by its square. ``mass``: lumped M1
     (Hughes) or M2 (row-summed consistent), thesis 3.14. ``damping``: mass-proportional
     coefficient in 1/s (0 = undamped, the default). ``mass_scaling`` and ``relaxation``
     reach a state of rest in fewer steps (``[solver.mass_scaling]``, ``[solver.relaxation]``).

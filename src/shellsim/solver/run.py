@@ -20,7 +20,7 @@ import numpy as np
 
 from ..deck import Deck
 from ..errors import NumericalError, OutputError, SceneTooLarge, place
-from ..loads import calibrate, contact_of_node, needs_calibration, stable_step
+from ..loads import calibrate, contact_of_node, needs_calibration, stable_step, step_share
 from ..mesh import Mesh
 from ..model import Model
 from ..measures import Measure, resolve_measures
@@ -195,7 +195,7 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
               quality=ElementQuality(mesh))
     if needs_calibration(model):
         s = run.sim.state
-        calibrate(model, s.mt, s.mr, run.sim.critical_time_step())
+        calibrate(model, s.mt, s.mr, springs_step(deck, model, run.sim.critical_time_step()))
         run.sim.evaluate_forces()  # the springs act from the start
     run.measures = resolve_measures(deck, mesh, model)
     run.history = {column: [] for measure in run.measures for column in measure.columns}
@@ -337,7 +337,20 @@ def _scale_masses(run: Run, listener: Listener) -> None:
     structure = _update_time_step(run, listener)
     if needs_calibration(run.model):  # the penalties' step and the contact nodes' masses are the scaled ones
         s = run.sim.state
-        calibrate(run.model, s.mt, s.mr, structure)
+        calibrate(run.model, s.mt, s.mr, springs_step(run.deck, run.model, structure))
+
+
+def springs_step(deck: Deck, model: Model, structure: float) -> float:
+    """The critical step the penalty springs are set on (:func:`shellsim.loads.calibrate`):
+    the structure's, ``structure``, or, where the deck's ``solver.dt_max`` holds the step
+    below the one the springs' share of it leaves stable, the critical step that step
+    stands for (dt_max x dt_safety_factor / share): springs as much stiffer as the shorter
+    step bears, with the same margin. Soft leaflets have a long step at rest; springs set
+    on it let the leaflets pressed together at full pressure sink into each other."""
+    solver = deck.solver
+    if solver.method != "explicit" or solver.dt_max is None:
+        return structure
+    return min(structure, solver.dt_max * solver.dt_safety_factor / step_share(model))
 
 
 def _check_stability(run: Run) -> None:

@@ -40,7 +40,8 @@ def imported(tmp_path_factory):
 def test_the_generated_leaflets_start_apart_near_closed_and_face_the_ventricle():
     """The builder's leaflets upside down: each leaflet's nodes the shape's gap from its
     neighbours' (no overlap at rest, the bands ready to meet), the free edges at z = -12,
-    each attachment's middle on the annulus (radius 15, z = 0), and every shell's normal
+    each leaflet's first row on the annulus ring (radius 15, z = 0) and moved, no other
+    node (the sides free, as an atrioventricular valve's commissures), and every shell's normal
     toward the ventricle (down, and on the upright bands toward the leaflet's own side,
     e_g), so that the pressure on SPOS lifts the bellies and presses the bands together."""
     valve = SyntheticValve(circumferential=8, belly=4, band=2, segments=3, tips=6)
@@ -50,8 +51,11 @@ def test_the_generated_leaflets_start_apart_near_closed_and_face_the_ventricle()
         nearest, _ = cKDTree(by_leaflet[(g + 1) % 3]).query(by_leaflet[g])
         assert nearest.min() == pytest.approx(SHAPE.gap, rel=1e-12)
         assert valve.points[valve.node(g, valve.rows, 4)][2] == pytest.approx(-SHAPE.height)
-        middle = valve.points[valve.node(g, 0, 4)]
-        assert (np.hypot(middle[0], middle[1]), middle[2]) == pytest.approx((SHAPE.base_radius, 0.0), abs=1e-12)
+        for j in range(valve.circumferential + 1):
+            x, y, z = valve.points[valve.node(g, 0, j)]
+            assert (np.hypot(x, y), z) == pytest.approx((SHAPE.base_radius, 0.0), abs=1e-12)
+    assert [label for label, _ in valve.annulus_motion()] == [valve.node(g, 0, j) for g in range(3)
+                                                              for j in range(valve.circumferential + 1)]
     for _, g, corners in valve.shells:
         a, b, c, d = (valve.points[n] for n in corners)
         side = np.radians(90.0 + 120.0 * g)

@@ -360,10 +360,12 @@ def _leaflet_of(x: np.ndarray) -> np.ndarray:
     return np.round((angle - 90.0) / 120.0).astype(int) % 3
 
 
-def valve_points(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+def valve_points(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray, ring: bool = False) -> np.ndarray:
     """Positions (n, 3) on leaflet k (n,) at u (n,) in [0, 1] from commissure to
     commissure and y (n,) in [0, 1] from the attachment (0) over the belly to the
-    coaptation band (1/2) and the free edge (1) (:class:`AorticValve`)."""
+    coaptation band (1/2) and the free edge (1) (:class:`AorticValve`). ``ring``: the
+    attachment an arc of the base circle at z = 0 (an atrioventricular valve's annulus),
+    its ends the gap apart, instead of the root's cusps rising to the posts."""
     half, rc, rb, cc = 0.5 * g.gap, g.commissure_radius, g.base_radius, g.coaptation_height
     centre = np.radians(90.0 + 120.0 * k)
     # the free edge: two straight branches gap / 2 off the planes between leaflets
@@ -377,9 +379,9 @@ def valve_points(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) ->
                             np.full(len(u), g.height)])
     band_foot = free - [0.0, 0.0, cc]
     # the attachment, from half the band foot's height under the commissures down to z = 0 mid-leaflet
-    offset = math.asin(half / rc)
+    offset = math.asin(half / (rb if ring else rc))
     around = (centre - np.pi / 3.0 + offset) + (2.0 * np.pi / 3.0 - 2.0 * offset) * u
-    w = np.sin(np.pi * u) ** 2  # level at the posts: the leaflet's corners there are square
+    w = np.ones(len(u)) if ring else np.sin(np.pi * u) ** 2  # level at the posts: the leaflet's corners there are square
     radius = rc + (rb - rc) * w
     attached = np.column_stack([radius * np.cos(around), radius * np.sin(around), 0.5 * (g.height - cc) * (1.0 - w)])
     points = band_foot + (2.0 * y - 1.0)[:, None] * (free - band_foot)
@@ -416,12 +418,12 @@ def onto_valve(x: np.ndarray, conn: np.ndarray, g: AorticValve) -> tuple[np.ndar
     return mapped, [], {"along_free_edge": along_free_edge(g, k[c], u[c], y[c])}
 
 
-def along_free_edge(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+def along_free_edge(g: AorticValve, k: np.ndarray, u: np.ndarray, y: np.ndarray, ring: bool = False) -> np.ndarray:
     """(n, 3) the unit direction of growing u (commissure to commissure, where a leaflet's
-    collagen runs) on leaflet k (n,) at u, y (n,) (:func:`valve_points`), by central
-    differences within [0, 1]."""
+    collagen runs) on leaflet k (n,) at u, y (n,) (:func:`valve_points`, ``ring`` as
+    there), by central differences within [0, 1]."""
     step = 1e-6
-    along = (valve_points(g, k, np.minimum(u + step, 1.0), y) - valve_points(g, k, np.maximum(u - step, 0.0), y))
+    along = (valve_points(g, k, np.minimum(u + step, 1.0), y, ring) - valve_points(g, k, np.maximum(u - step, 0.0), y, ring))
     return along / np.linalg.norm(along, axis=1, keepdims=True)
 
 

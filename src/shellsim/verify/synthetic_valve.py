@@ -4,18 +4,20 @@ and numbers are made up, the features are those of such a model.
 
 Geometry (mm): three separate leaflets of S4R shells in a near-closed position, each the
 aortic valve builder's leaflet (:func:`shellsim.geometry.builders.valve_points`) turned
-upside down: a belly from its attachment (the annulus, radius 15 at z = 0 under the
-leaflet's middle, rising to short commissure posts at radius 12.5 on either side) down to
-a vertical coaptation band 3 mm tall, whose lower edge is the free edge, at z = -12, along
-the two lines from the commissures to the axis, 0.5 mm from its neighbours'.
-``circumferential`` elements across each leaflet, ``belly`` + ``band`` from attachment to
-free edge (90 x (24 + 6) x 3 = 8,100 by default: beside the posts, where the belly's
-sections are shortest, its rows are 0.19 mm, near the free edge's 0.28 mm columns). A
-chord of ``segments`` T3D2 elements from each free-edge node down to one of ``tips``
-papillary tips (z = -25) in three groups, one under each leaflet (273 chords of 15
-elements, 4,095, by default). Under the ventricle's pressure the bellies rise and the
-bands press together, as the aortic valve's do under the aorta's; the chordae keep the
-free edges from turning up.
+upside down and hung from an arc of the annulus ring (radius 15, z = 0): a belly from the
+annulus down to a vertical coaptation band 3 mm tall, whose lower edge is the free edge,
+at z = -12, along the two lines from the commissures (radius 12.5) to the axis, 0.5 mm from
+its neighbours'. Only the annulus holds a leaflet: its sides are free, 0.5 mm from its
+neighbours' down to the free edge, as an atrioventricular valve's commissures are (the
+aortic root's posts, clamped down to the free edge, fold such soft leaflets where they
+meet the annulus). ``circumferential`` elements across each leaflet, ``belly`` + ``band``
+from the annulus to the free edge (90 x (24 + 6) x 3 = 8,100 by default: 0.27 mm columns
+along the free edge, 0.34 mm at the annulus; the belly's rows 0.41 mm beside the
+commissures, 0.81 mm mid-leaflet, the band's 0.5 mm). A chord of ``segments`` T3D2 elements from each free-edge node down to one
+of ``tips`` papillary tips (z = -25) in three groups, one under each leaflet (273 chords
+of 15 elements, 4,095, by default). Under the ventricle's pressure the bellies rise and
+the bands press together, as the aortic valve's do under the aorta's; the chordae keep
+the free edges from turning up.
 
 Abaqus file (mm-tonne-s, MPa):
 - each leaflet its own ``*SHELL SECTION`` (0.4 mm, 5 section points) and material of one
@@ -66,8 +68,8 @@ LEAFLETS = ("Anterior", "Posterior", "Septal")
 
 def _leaflet_points(g: int, u: np.ndarray, y: np.ndarray) -> np.ndarray:
     """(n, 3) leaflet g's points at u (n,) from commissure to commissure and y (n,) from
-    the attachment (0) to the free edge (1): the builder's, z turned over."""
-    return valve_points(SHAPE, np.full(len(u), g), u, y) * [1.0, 1.0, -1.0]
+    the annulus (0) to the free edge (1): the builder's hung from the ring, z turned over."""
+    return valve_points(SHAPE, np.full(len(u), g), u, y, ring=True) * [1.0, 1.0, -1.0]
 
 
 @dataclass(frozen=True)
@@ -169,15 +171,13 @@ class SyntheticValve:
         u) at its centre, where the collagen runs."""
         i, j = (a.ravel() for a in np.mgrid[0:self.rows, 0:self.circumferential])
         u, y = self._parameters(i + 0.5, j + 0.5)
-        return np.concatenate([along_free_edge(SHAPE, np.full(len(u), g), u, y) for g in range(3)]) * [1.0, 1.0, -1.0]
+        return np.concatenate([along_free_edge(SHAPE, np.full(len(u), g), u, y, ring=True)
+                               for g in range(3)]) * [1.0, 1.0, -1.0]
 
     def annulus_motion(self) -> list[tuple[int, np.ndarray]]:
-        """(label, displacement) of each attached node (the annulus and the commissure
-        posts): 5% inward and a saddle of 0.5 mm."""
-        attached = {self.node(g, i, j) for g in range(3) for i in range(self.rows + 1)
-                    for j in ((0, self.circumferential) if i else range(self.circumferential + 1))}
+        """(label, displacement) of each annulus node: 5% inward and a saddle of 0.5 mm."""
         out = []
-        for label in sorted(attached):
+        for label in (self.node(g, 0, j) for g in range(3) for j in range(self.circumferential + 1)):
             x, y, _ = self.points[label]
             t = np.arctan2(y, x)
             out.append((label, np.array([-0.05 * x, -0.05 * y, 0.5 * np.cos(2 * t)])))

@@ -11,13 +11,13 @@ The deck it runs is the imported one with these keys added (what a user adds by 
 unloaded step is longer, and they stiffen faster than estimates follow),
 ``[solver.mass_scaling] step, throughout = true``, the contact's ``penalty`` (its springs
 are set on the unloaded leaflets' step: at the default 0.1 the pressed leaflets sink into
-each other by half their thickness, at 1.0 the sides pressed together beside the
-commissures by 9%), ``end_time`` the file's step and a ``--hold`` at full pressure, and
+each other by half their thickness, at 1 and 2 the sides pressed together beside the
+commissures by 9% and 6%), ``end_time`` the file's step and a ``--hold`` at full pressure, and
 ``[output.valve]`` on the leaflets and the annulus. Prints the run's numbers as a Markdown
 table; nothing is asserted.
 
     .venv/bin/python benchmarks/tricuspid_closing.py OUT [--step 4e-5] [--damping 300]
-        [--penalty 2] [--hold 0.01] [--circumferential 90 --belly 24 --band 6 --segments 15 --tips 32]
+        [--penalty 3] [--hold 0.01] [--circumferential 90 --belly 24 --band 6 --segments 15 --tips 32]
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def main() -> None:
     parser.add_argument("out", type=Path, help="a new folder for the model, its deck and the run")
     parser.add_argument("--step", type=float, default=4e-5, help="the step the masses are scaled to [s]")
     parser.add_argument("--damping", type=float, default=300.0, help="mass-proportional damping [1/s]")
-    parser.add_argument("--penalty", type=float, default=2.0, help="the contact's penalty scale")
+    parser.add_argument("--penalty", type=float, default=3.0, help="the contact's penalty scale")
     parser.add_argument("--hold", type=float, default=0.01, help="the full pressure held after the file's step [s]")
     defaults = SyntheticValve()
     for key in ("circumferential", "belly", "band", "segments", "tips"):

@@ -84,7 +84,8 @@ def main() -> None:
         nearest = float(np.nanmin(last["contact_gap"][:]))  # nan: no face within reach
     valve_record = summary.get("valve", {})
     row = {"shells": summary["elements"], "status": summary["status"], "steps": summary["steps"],
-           "wall (s, the run's own)": wall, "mass factor": summary.get("mass_scaling", {}).get("factor", 1.0),
+           "run (s)": summary["wall_time_s"], "whole command (s)": wall,
+           "mass factor": summary.get("mass_scaling", {}).get("factor", 1.0),
            "nearest gap / h": nearest / THICKNESS, "balance (%)": summary["energy"]["balance_error_percent"],
            "contact's share of the step": summary["contact"]["share_of_step"],
            "us per element-step": summary["us_per_element_step"]}

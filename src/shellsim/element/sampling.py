@@ -12,11 +12,17 @@ from ..lanes import LANES
 from .groups import gather_element_values, gather_shape, group_count, lane_copy
 
 
+def integration_points(x: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray) -> np.ndarray:
+    """(ne, nq, 3) the mid-surface places of the in-plane integration points of the
+    elements ``conn`` (ne, 9), for nodes at x (n, 3); N_gauss (nq, 9)."""
+    return np.einsum("qa,eai->eqi", N_gauss, x[conn])
+
+
 def nearest_integration_point(x0: np.ndarray, conn: np.ndarray, N_gauss: np.ndarray,
                               location: np.ndarray) -> tuple[int, int]:
     """(element, in-plane point) of the mid-surface integration point nearest to
     ``location`` (3,) in the initial configuration; x0 (n, 3), conn (ne, 9), N_gauss (nq, 9)."""
-    points = np.einsum("qa,eai->eqi", N_gauss, x0[conn])
+    points = integration_points(x0, conn, N_gauss)
     flat = int(np.argmin(np.linalg.norm(points - location, axis=2)))
     return divmod(flat, len(N_gauss))
 

@@ -22,6 +22,7 @@ from scipy.ndimage import distance_transform_edt
 
 from ..bundles import Model
 from ..element.kinematics import fibre_point
+from ..element.sampling import integration_points
 from ..element.shape import EDGES
 from ..loads import ToolForces
 from ..mesh import Mesh, node_areas
@@ -313,7 +314,7 @@ def clear_of_annulus(model: Model, elements: np.ndarray, annulus: np.ndarray, cl
     ``clearance`` from the ``annulus`` nodes and the element edge halves between them, on
     the initial mid-surface."""
     conn = model.conn[elements]
-    points = np.einsum("qa,mai->mqi", model.rule.N[:len(model.rule.wq)], model.x0[conn])
+    points = integration_points(model.x0, conn, model.rule.N[:len(model.rule.wq)])
     halves = conn[:, EDGE_HALVES.ravel()].reshape(-1, 2)
     halves = halves[np.isin(halves, annulus).all(axis=1)]
     starts = np.concatenate([model.x0[halves[:, 0]], model.x0[annulus]])

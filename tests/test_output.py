@@ -257,7 +257,9 @@ def _plate_simulation(displacement, director=None):
 def test_sub_cells_carry_their_gauss_points_values_and_the_nodal_version_is_exact_for_quadratics():
     """u_x = a x^2 gives E_xx = 2 a x + 2 a^2 x^2 (quadratic in x), exactly represented by
     the 9-node element on a regular mesh: every sub-cell holds the value at the Gauss point
-    inside it, and the smoothed nodal version equals the closed form at every corner."""
+    inside it, and the smoothed nodal version equals the closed form at every corner,
+    clipped to the Gauss values' range: beyond the outermost Gauss points, at the plate's
+    ends, the closed form leaves it."""
     a = 0.05
     run = _plate_simulation(lambda x0: np.column_stack([a * x0[:, 0] ** 2, 0 * x0[:, 0], 0 * x0[:, 0]]))
     mesh = output_mesh(run.model)
@@ -268,8 +270,30 @@ def test_sub_cells_carry_their_gauss_points_values_and_the_nodal_version_is_exac
     inside = (corners[:, :, 0].min(axis=1) < gauss_x) & (gauss_x < corners[:, :, 0].max(axis=1))
     assert inside.all()
     np.testing.assert_allclose(cell_data["green_lagrange_strain"][:, 0], exx(gauss_x), rtol=1e-10)
-    np.testing.assert_allclose(point_data["green_lagrange_strain_nodal"][:, 0], exx(mesh.points[:, 0]), rtol=1e-9, atol=1e-11 * exx(2.0))
+    gauss_range = cell_data["green_lagrange_strain"][:, 0].min(), cell_data["green_lagrange_strain"][:, 0].max()
+    closed_form = exx(mesh.points[:, 0])
+    assert (closed_form < gauss_range[0]).any() and (closed_form > gauss_range[1]).any()  # the ends clip
+    np.testing.assert_allclose(point_data["green_lagrange_strain_nodal"][:, 0], np.clip(closed_form, *gauss_range),
+                               rtol=1e-9, atol=1e-11 * exx(2.0))
     assert np.abs(cell_data["green_lagrange_strain"][:, [1, 2]]).max() < 1e-14  # nothing along y or z
+
+
+def test_no_smoothed_field_leaves_the_range_of_its_integration_point_values():
+    """A stretch that starts halfway along the left elements (u_x = a max(x - 1/2, 0)^2, a
+    kink no biquadratic follows) makes the extrapolated nodal values undershoot: every
+    ``_nodal`` field, the principal stresses' too, stays within its cell values' range,
+    each component's, and the von Mises stress's never falls below zero."""
+    a = 0.05
+    run = _plate_simulation(lambda x0: np.column_stack(
+        [a * np.maximum(x0[:, 0] - 0.5, 0.0) ** 2, 0 * x0[:, 0], 0 * x0[:, 0]]))
+    point_data, cell_data = frame_fields(run.sim, output_mesh(run.model), [
+        "cauchy_stress", "pressure_band", "green_lagrange_strain", "von_mises", "principal_stress"])
+    smoothed = [name for name in point_data if name.endswith("_nodal")]
+    assert {"von_mises_nodal", "principal_stress_1_nodal", "principal_stress_3_nodal"} <= set(smoothed)
+    for name in smoothed:
+        cells, nodal = cell_data[name.removesuffix("_nodal")], point_data[name]
+        assert (nodal >= cells.min(axis=0)).all() and (nodal <= cells.max(axis=0)).all(), name
+    assert point_data["von_mises_nodal"].min() == cell_data["von_mises"].min() >= 0.0  # clipped at the kink
 
 
 def test_von_mises_is_per_layer_in_the_solid_view_and_its_largest_in_the_shell_view():
@@ -649,7 +673,7 @@ def test_the_carotid_plots_against_its_whole_lumen_pressure_in_mmhg():
     deck = load_deck(ROOT / "decks" / "tissue" / "carotid_hgo_pulse.toml")
     t = np.linspace(0.0, 2.4, 241)
     pressure, label = _load_axis(deck, t, DisplayUnits.of(deck))
-    assert label == "pressure on 'all' (mmHg)"
+    assert label == "pressure on the bottom face (mmHg)"  # the lumen's: 'all' of the wall goes unsaid
     pascals = 10.666e3 * deck.curves["diastole"](t) + deck.curves["pulse"](t)  # the pulse curve is in Pa
     np.testing.assert_allclose(pressure, pascals / 133.322387415, rtol=1e-12)
     csv = np.loadtxt(ROOT / "decks" / "tissue" / "carotid_pulse.csv", delimiter=",", skiprows=2)
@@ -735,7 +759,24 @@ def test_the_colour_bar_spans_the_finite_values_and_an_infinite_one_is_drawn_as_
     from shellsim.output.render import _finite_or_missing, colour_limits
 
     frames = [_finite_or_missing(np.array([0.2, np.inf, 0.5])), _finite_or_missing(np.array([np.nan, -np.inf, 0.1]))]
-    assert colour_limits(frames) == (0.1, 0.5)
+    assert colour_limits(frames) == (0.1, 0.5, "")
     assert np.isnan(frames[0][1]) and np.isnan(frames[1][1])
-    assert colour_limits([np.full(3, 2.0)]) == (1.0, 3.0)
-    assert colour_limits([np.full(2, np.nan)]) == (-0.5, 0.5)
+    assert colour_limits([np.full(3, 2.0)])[:2] == (1.0, 3.0)
+    assert colour_limits([np.full(2, np.nan)])[:2] == (-0.5, 0.5)
+
+
+def test_the_colour_limits_leave_out_a_single_outlying_cell_and_say_so():
+    """The default scene's case: 98% of a vessel's hoop stress between 55 and 93 kPa, one
+    sub-cell at 139. The robust bar ends below that cell and the picture's note gives the
+    whole range; 'full' spans it; a field without strays, and a given range, are as they
+    are."""
+    from shellsim.output.render import colour_limits
+
+    vessel = np.random.default_rng(3).uniform(55.0, 93.0, 4000)
+    with_outlier = [vessel[:2000], np.append(vessel[2000:], 139.0)]
+    low, high, note = colour_limits(with_outlier, "robust", "kPa")
+    assert 55.0 <= low < 56.0 and 92.0 < high <= 93.0
+    assert "middle 98% of the values" in note and note.endswith(f"all lie in {vessel.min():.4g} to 139 kPa")
+    assert colour_limits(with_outlier, "full")[:2] == (vessel.min(), 139.0)
+    assert colour_limits([np.linspace(55.0, 93.0, 4000)]) == (55.0, 93.0, "")
+    assert colour_limits(with_outlier, (60.0, 90.0)) == (60.0, 90.0, "")

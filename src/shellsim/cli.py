@@ -379,12 +379,13 @@ def _size(value: str) -> tuple[int, int]:
 
 @app.command()
 @reports_errors
-def render(
+def render(  # noqa: PLR0913 (the command's options, each defaulted)
     results: Annotated[Path, typer.Argument(help="A run's output folder.", show_default=False)],
     field: Annotated[str, typer.Option(help="Field to colour by (as written: pressure_band, von_mises, "
                                             "cauchy_stress, displacement, thickness, ..._nodal).")] = "pressure_band",
     component: Annotated[str | None, typer.Option(help="Component of a vector (x, y, z, magnitude) or "
-                                                       "tensor (xx, yy, zz, xy, yz, zx) field.")] = None,
+                                                       "tensor (XX, YY, ZZ, XY, YZ, XZ; either case, either "
+                                                       "order) field.")] = None,
     frame: Annotated[str, typer.Option(help="'last', 'all' (also an animated GIF) or a frame number "
                                             "(negative counts from the end).")] = "last",
     view: Annotated[str, typer.Option(help="iso, top, front or side.")] = "iso",
@@ -393,6 +394,10 @@ def render(
     show: Annotated[list[str] | None, typer.Option(help="Draw also (repeat for both): 'fibres', the fibre "
                                                         "directions (written with output.fields 'fibres'); "
                                                         "'outline', the initial shape's element outlines.")] = None,
+    colour_range: Annotated[str, typer.Option(
+        "--range", help="The colour bar's limits: 'robust' (the middle 98% of the values, where a few stray "
+                        "ones would take the scale; the picture says so), 'full' (every value), or 'LOW,HIGH' "
+                        "in the units shown.")] = "robust",
 ) -> None:
     """Render a field of a run on its deformed shape: off-screen PNGs with a labelled scalar
     bar, element outlines, and each sub-cell coloured by its integration point's value."""
@@ -407,8 +412,23 @@ def render(
     with err.status(f"rendering {field}") as status:
         written = render_field(results, field, _frame_choice(frame), view, _size(size), component, out_dir,
                                Overlays(**{name: True for name in show or []}),
-                               lambda done, total: status.update(f"rendering {field}: {done} of {total} frames"))
+                               lambda done, total: status.update(f"rendering {field}: {done} of {total} frames"),
+                               _colour_range(colour_range))
     _announce(written)
+
+
+def _colour_range(text: str) -> str | tuple[float, float]:
+    """--range: 'robust', 'full' or 'LOW,HIGH' with LOW < HIGH."""
+    if text in ("robust", "full"):
+        return text
+    try:
+        low, high = (float(part) for part in text.split(","))
+    except ValueError:
+        low = high = float("nan")
+    if not low < high:
+        raise typer.BadParameter(f"got '{text}'; expected robust, full or LOW,HIGH with LOW < HIGH (e.g. 50,95)",
+                                 param_hint="--range")
+    return low, high
 
 
 @app.command()

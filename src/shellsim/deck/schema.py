@@ -28,9 +28,10 @@ Axis = Literal["x", "y", "z"]
 
 #: Each unit system's units of length, stress (and pressure) and time (``consistent``
 #: names none).
-SYSTEMS = {name: {"length": length, "stress": stress, "pressure": stress, "time": time}
-           for name, (length, stress, time) in {"SI": ("m", "Pa", "s"), "mm-t-s": ("mm", "MPa", "s"),
-                                                 "mm-kg-ms": ("mm", "GPa", "ms"), "in-lbf-s": ("in", "psi", "s")}.items()}
+SYSTEMS = {name: {"length": length, "stress": stress, "pressure": stress, "time": time, "energy": energy}
+           for name, (length, stress, time, energy) in {
+               "SI": ("m", "Pa", "s", "J"), "mm-t-s": ("mm", "MPa", "s", "mJ"), "mm-kg-ms": ("mm", "GPa", "ms", "J"),
+               "in-lbf-s": ("in", "psi", "s", "in lbf")}.items()}
 SYSTEMS["consistent"] = {}
 #: The units a render or plot may show, by kind, each with its size in SI units. A
 #: pressure (a pressure load) may be shown in other units than the stresses.
@@ -406,7 +407,9 @@ class Render(Section):
     ``hoop_stress`` of ``vessel_stress``) on the deformed shape, for the ``last`` frame,
     a frame number, or ``all`` (also an animated GIF), seen from ``view``, ``size`` pixels;
     ``fibres`` draws the fibre directions over it (with ``fibres`` among the fields),
-    ``outline`` the initial shape's element outlines."""
+    ``outline`` the initial shape's element outlines; ``range`` the colour bar's limits:
+    ``robust`` (the middle 98% of the values where a few stray ones would take the scale,
+    which the picture then says), ``full`` or [low, high] in the units shown."""
 
     field: Drawn = "pressure_band"
     frame: Literal["last", "all"] | Count = "last"
@@ -414,6 +417,14 @@ class Render(Section):
     size: tuple[Count, Count] = (1200, 900)
     fibres: bool = False
     outline: bool = False
+    range: Literal["robust", "full"] | tuple[float, float] = "robust"
+
+    @field_validator("range")
+    @classmethod
+    def _rising(cls, limits):
+        if not isinstance(limits, str) and not limits[0] < limits[1]:
+            raise ValueError(f"got {list(limits)}; expected [low, high] with low < high")
+        return limits
 
     @field_validator("field")
     @classmethod
@@ -426,8 +437,10 @@ class Render(Section):
 
 
 class _Output(Section):
-    """``[output]``: frames at t = 0 and every ``interval`` (or at the listed ``times``,
-    which the time stepper lands on exactly) and at the end; the ``fields`` written in
+    """``[output]``: frames at t = 0, every ``interval``, at the listed ``times`` (both
+    landed on exactly: a static solve's load steps, whose states the history records,
+    end there too, so a few ``times`` where the load rises fast draw its curve) and at the
+    end; the ``fields`` written in
     them (stresses and strains per integration-point sub-cell, with a smoothed nodal
     version); the ``formats`` (``xdmf``: results.xdmf + results.h5; ``vtu``: results.pvd +
     frames/), their numbers' ``precision`` (``single``: about 7 digits, half the size of
@@ -463,9 +476,7 @@ class _Output(Section):
     render: list[Render] = []
 
     @model_validator(mode="after")
-    def _one_schedule(self) -> "_Output":
-        if self.interval is not None and self.times is not None:
-            raise ValueError("give either 'interval' or 'times', not both")
+    def _consistent(self) -> "_Output":
         if self.times is not None and any(b <= a for a, b in zip(self.times, self.times[1:])):
             raise ValueError(f"'times' must be strictly increasing, got {self.times}")
         written_by = {name: field for field, names in WRITTEN_AS.items() for name in names}

@@ -211,12 +211,17 @@ def fibre_vectors(sim: Simulation, layers: list[int]) -> list[np.ndarray]:
 def _smoothed(model: Model, mesh: OutputMesh, cell_values: np.ndarray) -> np.ndarray:
     """Nodal version (ne * 16, ...) at the shell view's corners of per-point values
     (ne, 9, ...): the biquadratic through an element's 3 x 3 Gauss values, read at its
-    nodes, averaged over the elements sharing each node, interpolated back to the corners."""
+    nodes, averaged over the elements sharing each node, interpolated back to the corners,
+    and clipped to the range of the per-point values (each column's own): extrapolated
+    to the nodes and read between them, a quadratic overshoots where a field turns
+    sharply, and a von Mises stress below zero, or a peak above any the element holds,
+    is not one to show."""
     at_nodes = np.einsum("aq,eq...->ea...", mesh.gauss_to_nodes, cell_values)
     total = np.zeros((model.n_nodes, *cell_values.shape[2:]))
     np.add.at(total, model.conn, at_nodes)
     count = np.maximum(mesh.elements_at_node, 1)  # a cable's own node is on no element
-    return _at_corners(total / count.reshape(-1, *([1] * (total.ndim - 1))), model.conn, 1)
+    corners = _at_corners(total / count.reshape(-1, *([1] * (total.ndim - 1))), model.conn, 1)
+    return np.clip(corners, np.nanmin(cell_values, axis=(0, 1)), np.nanmax(cell_values, axis=(0, 1)))
 
 
 def _columns(values: np.ndarray) -> np.ndarray:
@@ -378,7 +383,11 @@ def frame_fields(sim: Simulation, mesh: OutputMesh, fields: list[str], vessel_ax
                 cell_data[kind.name] = _columns(through.reshape(len(mesh.cells), -1))
                 point_data[kind.name + NODAL_SUFFIX] = _columns(_smoothed(model, mesh, through))
         else:
-            cell_data |= {name: _on_cells(array, mesh) for name, array in COMPUTE[kind.name](frame, None).items()}
+            arrays = COMPUTE[kind.name](frame, None)
+            cell_data |= {name: _on_cells(array, mesh) for name, array in arrays.items()}
+            if kind.measures == "stress" and not mesh.solid:  # the stresses' smoothed versions
+                point_data |= {name + NODAL_SUFFIX: _smoothed(model, mesh, arrays[name][:, :, 0])
+                               for name in kind.written_as}
     for face in () if mesh.solid else faces:  # the integration layer nearest the face
         k = 0 if face == "bottom" else len(model.rule.tz) - 1
         for name, flat in flats.items():

@@ -19,6 +19,8 @@ from .history import read_history
 from .units import DisplayUnits
 
 PLOTS_DIR = "plots"
+#: Curves of at most this many points show each (a static solve's load steps).
+MARKED_POINTS = 200
 #: How each reference measure is drawn: as points on the curve, or as a level.
 POINT_MEASURES = ("at_time", "final")
 LEVEL_MEASURES = ("max", "min", "max_abs")
@@ -48,8 +50,17 @@ def _load_axis(deck, times: np.ndarray, units: DisplayUnits) -> tuple[np.ndarray
     first = curved[0]
     place = lambda load: (load.type, load.set, getattr(load, "face", None))  # noqa: E731
     total = sum(load.value * deck.curves[load.curve](times) for load in curved if place(load) == place(first))
-    label = f"{first.type.replace('_', ' ')} on '{first.set}'"
-    return units.scale(first.QUANTITY) * total, units.label(label, first.QUANTITY)
+    return units.scale(first.QUANTITY) * total, units.label(_load_name(first), first.QUANTITY)
+
+
+def _load_name(load) -> str:
+    """What a load is, for an axis: 'pressure on the bottom face', 'edge pressure on
+    inlet', ... ('all' of the shell goes unsaid)."""
+    where = [] if load.set == "all" else [f"on {load.set}"]
+    face = getattr(load, "face", None)
+    if face is not None:
+        where.append(f"{'on' if not where else 'from'} the {face} face")
+    return " ".join([load.type.replace("_", " "), *where])
 
 
 def plot_run(folder: Path, out_dir: Path | None = None, size: tuple[float, float] = (9.0, 4.0)) -> list[Path]:
@@ -78,15 +89,18 @@ def _plot_run(folder: Path, out_dir: Path | None, size: tuple[float, float]) -> 
         t, values = times[measured], scale * history[name][measured]
         figure = Figure(figsize=(size[0] if load else 0.6 * size[0], size[1]), layout="constrained")
         axes = figure.subplots(1, 2 if load else 1, squeeze=False)[0]
-        ylabel = units.label(name, quantity)
+        ylabel = units.label(name.replace("_", " "), quantity)
         for ax, x, xlabel in zip(axes, (units.scale("time") * t, *((load[0][measured],) if load else ())),
                                  (units.label("time", "time"), *(load[1:] if load else ()))):
-            ax.plot(x, values, color="black", lw=1.4, label="shellsim")
+            ax.plot(x, values, color="black", lw=1.4, label="this run" + ("" if whole else " (stopped early)"),
+                    marker="." if len(t) <= MARKED_POINTS else None, ms=4)
             _draw_references(ax, deck, name, t, x, scale, units.scale("time") if ax is axes[0] else None, whole)
             ax.set_xlabel(xlabel)
             ax.set_ylabel(ylabel)
             ax.grid(alpha=0.3)
-        figure.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", fontsize="small", ncols=2)
+        entries = dict(zip(*reversed(axes[0].get_legend_handles_labels())))  # each label once
+        if len(entries) > 1 or not whole:  # a lone curve of this run needs no legend
+            figure.legend(entries.values(), entries.keys(), loc="outside lower center", fontsize="small")
         figure.suptitle(deck.meta.title, fontsize="medium")
         written.append(_save(figure, out_dir / f"{name}.png"))
     written.append(_plot_energy(deck, history, out_dir / "energy.png", size))
@@ -107,19 +121,19 @@ def _draw_references(ax, deck, probe: str, times: np.ndarray, x: np.ndarray, sca
         refs = [r for r in deck.reference if r.probe == probe and r.measure == measure
                 and (whole or r.time <= times[-1])]
         colour = next(colours, "grey")
-        label = f"reference ({measure.replace('_', ' ')}): {refs[0].source}"
+        label = _wrapped(f"reference ({measure.replace('_', ' ')}): {refs[0].source}")
         if measure in POINT_MEASURES:
             at = [times[-1] if r.measure == "final" else r.time for r in refs]
             ax.errorbar(np.interp(at, times, x), [scale * r.expected for r in refs], fmt="o", color=colour, ms=5,
-                        yerr=[scale * _tolerance(r) for r in refs], capsize=3, label=_short(label))
+                        yerr=[scale * _tolerance(r) for r in refs], capsize=3, label=label)
         elif measure in LEVEL_MEASURES:
             for r in refs:
                 for level in ((scale * r.expected, -scale * r.expected) if measure == "max_abs"
                               else (scale * r.expected,)):
-                    ax.axhline(level, color=colour, ls="--", lw=1, label=_short(label))
+                    ax.axhline(level, color=colour, ls="--", lw=1, label=label)
         elif measure == "first_peak_time" and time_scale is not None:
             for r in refs:
-                ax.axvline(time_scale * r.expected, color=colour, ls="--", lw=1, label=_short(label))
+                ax.axvline(time_scale * r.expected, color=colour, ls="--", lw=1, label=label)
 
 
 def _tolerance(reference) -> float:
@@ -129,8 +143,11 @@ def _tolerance(reference) -> float:
     return abs(reference.expected) * reference.tolerance_percent / 100.0
 
 
-def _short(text: str, limit: int = 70) -> str:
-    return text if len(text) <= limit else text[:limit - 3] + "..."
+def _wrapped(text: str, width: int = 100) -> str:
+    """A legend entry in full, on lines of at most ``width`` characters."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width))
 
 
 def _plot_energy(deck, history: dict[str, np.ndarray], path: Path, size: tuple[float, float]) -> Path:
@@ -149,7 +166,7 @@ def _plot_energy(deck, history: dict[str, np.ndarray], path: Path, size: tuple[f
     names = " + ".join(column.split("_")[0] for column in kept)
     ax.plot(t, balance, color="black", ls=":", label=f"balance ({names} - external)")
     ax.set_xlabel(units.label("time", "time"))
-    ax.set_ylabel("energy")
+    ax.set_ylabel(units.label("energy", "energy"))
     ax.grid(alpha=0.3)
     ax.legend(fontsize="small")
     figure.suptitle(deck.meta.title, fontsize="medium")

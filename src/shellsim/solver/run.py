@@ -205,16 +205,13 @@ def prepare(deck: Deck, mesh: Mesh, model: Model) -> Run:
 
 
 def output_times(deck: Deck) -> np.ndarray:
-    """Times the run lands on exactly: the deck's output times (or every output interval)
-    and the end time."""
+    """Times the run lands on exactly: every output interval, the deck's output times and
+    the end time."""
     end = deck.solver.end_time
     out = deck.output
-    if out.times is not None:
-        marks = np.asarray([t for t in out.times if 0.0 < t <= end])
-    elif out.interval is not None:
-        marks = np.arange(out.interval, end, out.interval)
-    else:
-        marks = np.zeros(0)
+    marks = np.asarray([t for t in out.times or () if 0.0 < t <= end])
+    if out.interval is not None:
+        marks = np.append(marks, np.arange(out.interval, end, out.interval))
     times = np.unique(np.append(marks, end))
     return times[times > 0.0]
 

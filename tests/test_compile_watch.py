@@ -3,9 +3,13 @@ they call compile inside them), each with its name and duration."""
 
 from __future__ import annotations
 
+import pytest
 from numba import njit
+from typer.testing import CliRunner
 
 from shellsim.compile_watch import watching_compiles
+
+from .conftest import CLAMPED_PLATE, deck_text
 
 
 def test_each_outermost_compilation_is_told_once_with_its_name_and_duration():
@@ -60,3 +64,44 @@ def test_the_run_progress_tells_the_compiling_once_and_each_long_kernel():
         assert fields["status"] == before and fields["compiling_since"] is None
     finally:
         bar.close()
+
+
+def test_the_time_left_follows_the_step_and_a_newton_path_gets_a_range():
+    """Explicit: the steps still to go at the current step, each at the recent wall time
+    per step; the step halving doubles the time left at once. Newton steps: the
+    simulated time still to go at the middle half of the recent rates."""
+    from shellsim.output.progress import Pace, left_text
+
+    pace = Pace()
+    assert pace.left(1.0, 1e-3) is None and left_text(None) == "-"
+    for k in range(5):  # 100 steps of 1e-3 a wall second
+        pace.add(0.1 * k, 100 * k, now=float(k))
+    soonest, latest = pace.left(1.0, 1e-3)
+    assert soonest == latest == pytest.approx(600 * 0.01)  # 600 steps at 10 ms
+    assert pace.left(1.0, 0.5e-3)[0] == pytest.approx(1200 * 0.01)
+    assert left_text((12.0, 12.0)) == "about 0:12 left"
+
+    newton = Pace()
+    for wall, t in [(0.0, 0.0), (1.0, 0.1), (3.0, 0.2), (4.0, 0.3), (8.0, 0.4)]:  # 10, 20, 10, 40 s per unit
+        newton.add(t, 0, now=wall)
+    soonest, latest = newton.left(1.0, None)
+    assert soonest == pytest.approx(0.6 * 10.0) and latest == pytest.approx(0.6 * 25.0)
+    assert left_text((soonest, latest)) == "0:06-0:15 left"
+    assert left_text((3725.0, 3725.0)) == "about 1:02:05 left"
+
+
+def test_a_static_solve_shows_its_own_columns(tmp_path):
+    """A static run's progress lines name its load steps, iterations and tangents, never
+    an explicit step's rate or balance; the closing lines say where to look."""
+    from shellsim.cli import app
+
+    deck = tmp_path / "static.toml"
+    deck.write_text(deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0', CLAMPED_PLATE[1]).replace(
+        "[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0\n[output]\ninterval = 0.25').replace(
+        "thickness = 0.01", "thickness = 0.1"))
+    result = CliRunner().invoke(app, ["run", str(deck), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    lines = [line for line in result.output.splitlines() if line.startswith("t = ")]
+    assert len(lines) >= 4 and all("load step" in line and "iterations" in line and "steps/s" not in line
+                                   and "balance" not in line for line in lines)
+    assert "paraview" in result.output and "results.xdmf" in result.output

@@ -17,6 +17,7 @@ what it expects, an :class:`~shellsim.errors.OutputError` naming the file.
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -34,22 +35,36 @@ def load(deck: str | Path | dict, base_dir: str | Path | None = None) -> Deck:
     return load_deck(deck)
 
 
-def run(deck: Deck | str | Path | dict, out: str | Path, base_dir: str | Path | None = None,
-        renders: bool = True) -> Results:
+def run(deck: Deck | str | Path | dict, out: str | Path, base_dir: str | Path | None = None,  # noqa: PLR0913 (each defaulted)
+        renders: bool = True, progress: bool | Callable[[dict], None] = True) -> Results:
     """Run a scene (a :class:`~shellsim.deck.Deck`, a deck file or a dict, as :func:`load`
     takes) into the folder ``out``: the files and renders ``shellsim run`` writes. Returns
     its :class:`Results`; a run that ends short (unstable, not converged, interrupted)
-    returns too, its ``status`` and ``summary["message"]`` telling why."""
+    returns too, its ``status`` and ``summary["message"]`` telling why. ``progress``:
+    True shows what ``shellsim run`` shows on the standard error (the stages, compiling,
+    a bar on a terminal or a line every tenth of the run), False nothing, a function is
+    called at every history sample with ``{"t", "end_time", "steps", "status"}`` (the
+    status the bar shows)."""
+    from contextlib import closing
+
+    from rich.console import Console
+
+    from .compile_watch import watching_compiles
     from .execute import run_scene
     from .output.folder import claimed, output_folder
+    from .output.progress import ProgressDisplay, ProgressCallback
     from .output.render import deck_renders
 
     is_file = isinstance(deck, (str, Path))
     scene = deck if isinstance(deck, Deck) else load(deck, base_dir)
     deck_path = Path(deck) if is_file else Path(base_dir or Path.cwd()) / "deck.toml"
     folder = output_folder(Path(out))
+    end = scene.solver.end_time
+    shown = ProgressDisplay(Console(stderr=True), end, quiet=progress is not True)
+    listener = ProgressCallback(progress, shown) if callable(progress) else shown
     with claimed(folder):  # the renders too
-        current, _ = run_scene(scene, deck_path, folder)
+        with closing(shown), watching_compiles(shown.compiling, shown.compiled):
+            current, _ = run_scene(scene, deck_path, folder, listener, shown.announce)
         if renders and current.status == "completed":
             deck_renders(scene, folder)
     return Results(folder)

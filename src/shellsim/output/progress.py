@@ -1,14 +1,16 @@
-"""Progress of a run: a rich bar on a terminal (simulated time, step, steps per second,
-energy balance, the worst element's Jacobian ratio J/J0, time left; on a first run the
-kernel compiling and its clock), a line every tenth of the run otherwise, nothing when
-quiet."""
+"""Progress of a run: a rich bar on a terminal (simulated time, the columns of the
+solution path, the worst element's Jacobian ratio J/J0, the time left at the recent pace;
+on a first run the kernel compiling and its clock), a line every tenth of the run
+otherwise, nothing when quiet."""
 
 from __future__ import annotations
 
 import time
 
+import numpy as np
+
 from rich.console import Console
-from rich.progress import BarColumn, Progress, ProgressColumn, TextColumn, TimeRemainingColumn
+from rich.progress import BarColumn, Progress, ProgressColumn, TextColumn
 from rich.text import Text
 
 from ..compile_watch import FIRST_RUN_NOTE, finished_text
@@ -23,36 +25,91 @@ def _static(run: Run) -> bool:
 
 
 class _Clock(ProgressColumn):
-    """The time left while stepping; while a kernel compiles, how long it has compiled
-    (ticking: the bar redraws itself)."""
-
-    def __init__(self):
-        super().__init__()
-        self.remaining = TimeRemainingColumn()
+    """The time left (the display's own forecast, ``left``); while a kernel compiles, how
+    long it has compiled (ticking: the bar redraws itself)."""
 
     def render(self, task) -> Text:
         since = task.fields["compiling_since"]
         if since is None:
-            return self.remaining.render(task)
+            return Text(task.fields["left"], style="progress.remaining")
         seconds = int(time.perf_counter() - since)
-        return Text(f"{seconds // 60}:{seconds % 60:02d}", style="progress.elapsed")
+        return Text(f"compiling {seconds // 60}:{seconds % 60:02d}", style="progress.elapsed")
+
+
+def clock(seconds: float) -> str:
+    """'0:42', '12:05', '3:02:10'."""
+    seconds = int(round(seconds))
+    hours, rest = divmod(seconds, 3600)
+    return (f"{hours}:" if hours else "") + (f"{rest // 60:02d}" if hours else f"{rest // 60}") + f":{rest % 60:02d}"
+
+
+class Pace:
+    """How fast a run goes lately: its samples' (wall clock, simulated time, steps) over
+    the last WINDOW seconds of wall time (at least the last two), and from them the time
+    left. Explicit: the steps still to take at the current step, each at the recent wall
+    time per step, so the forecast follows a falling step at once. Newton steps (whose
+    lengths vary): the simulated time still to go at the recent rates between samples,
+    the middle half of them giving a range."""
+
+    WINDOW = 30.0
+
+    def __init__(self):
+        self.samples: list[tuple[float, float, int]] = []
+
+    def add(self, t: float, steps: int, now: float | None = None) -> None:
+        """A sample at simulated time ``t`` after ``steps`` steps, at the wall clock ``now``
+        (perf_counter's, by default)."""
+        now = time.perf_counter() if now is None else now
+        self.samples.append((now, t, steps))
+        while len(self.samples) > 2 and now - self.samples[1][0] > self.WINDOW:
+            self.samples.pop(0)
+
+    def left(self, end_time: float, dt: float | None) -> tuple[float, float] | None:
+        """(soonest, latest) seconds to ``end_time`` at the recent pace, the step ``dt`` on
+        (explicit) or None (Newton steps); None while it is not known."""
+        pairs = list(zip(self.samples, self.samples[1:]))
+        to_go = end_time - self.samples[-1][1] if self.samples else 0.0
+        if dt:
+            (w0, _, n0), (w1, _, n1) = (self.samples[0], self.samples[-1]) if pairs else ((0, 0, 0),) * 2
+            return ((to_go / dt * (w1 - w0) / (n1 - n0),) * 2) if n1 > n0 else None
+        rates = [(b[0] - a[0]) / (b[1] - a[1]) for a, b in pairs if b[1] > a[1]]
+        return tuple(to_go * np.percentile(rates, [25, 75])) if rates else None  # the middle half of the rates
+
+
+def left_text(span: tuple[float, float] | None) -> str:
+    """'about 1:23 left', '1:10-2:40 left' where the range is wide, '-' before it is known."""
+    if span is None:
+        return "-"
+    soonest, latest = span
+    if latest <= 1.25 * soonest:
+        return f"about {clock(0.5 * (soonest + latest))} left"
+    return f"{clock(soonest)}-{clock(latest)} left"
 
 
 class ProgressDisplay(Listener):
+    """A run's progress on ``console``: a bar on a terminal, a line every tenth of the run
+    otherwise, nothing when ``quiet``; each with the columns of its path (explicit: the
+    step, steps per second, the energy balance; static or implicit: the load or time
+    step, its iterations and tangents, its residual; both: the worst element's J/J0) and
+    the time left at the recent pace (:class:`Pace`)."""
+
     def __init__(self, console: Console, end_time: float, quiet: bool = False):
         self.console = console
         self.end_time = end_time
         self.quiet = quiet
         self.stepping_since = (time.perf_counter(), 0)  # (clock, steps) where the steps' rate starts
+        self.pace = Pace()
         self.next_line = 0.1
         self.bar: Progress | None = None
-        self.status = "dt -  - steps/s  balance -  J/J0 -"
+        self.status = "starting"
         if not quiet and console.is_terminal:
             self.bar = Progress(TextColumn("[bold]t = {task.fields[t]}"), BarColumn(), TextColumn("{task.fields[status]}"),
                                 _Clock(), console=console, transient=True)
-            self.task = self.bar.add_task("run", total=end_time, t="0", status=self.status, compiling_since=None)
+            self.task = self.bar.add_task("run", total=end_time, t="0", status=self.status, compiling_since=None,
+                                          left="-")
             self.bar.start()
         self.compiled_any = False
+        self.forecast_told = False
 
     def announce(self, text: str) -> None:
         """A stage of the work before the first step (meshing, the mesh's size, building)."""
@@ -76,49 +133,66 @@ class ProgressDisplay(Listener):
             self.announce(text)
 
     def on_dt(self, run: Run) -> None:
-        """At the first estimate: the step and what the run will cost."""
-        if len(run.dt_history) != 1:
-            return
-        self.stepping_since = (time.perf_counter(), run.sim.state.steps)  # not the compiling before
-        if self.quiet:
-            return
-        from ..solver.outlook import contact_seconds, duration, stepping
+        """At the start (the estimates at t = 0, a mass scaling's among them): the step and
+        what the run will cost, said once the last of them is in (at the first sample)."""
+        if run.sim.state.t == 0.0:
+            self.stepping_since = (time.perf_counter(), run.sim.state.steps)  # not the compiling before
 
-        contact = contact_seconds(run.model, run.load_time, run.sim.state.fields.shape)
-        steps, cost = stepping(run.deck.solver.end_time, run.dt, run.model.n_elements, contact)
-        self.announce(f"critical step {run.dt_critical:.4g}, step {run.dt:.4g}: about {steps:,.0f} steps, "
-                      f"about {duration(cost)} of stepping ({duration(cost / run.deck.solver.end_time)} "
-                      "per unit of simulated time" + (", contact's included" if contact else "") + ")")
+    def _forecast(self, run: Run) -> None:
+        """The explicit steps' start: the step, the steps it takes to the end, and that the
+        time left (known after a few samples) follows the step as it changes."""
+        steps = (run.deck.solver.end_time - run.sim.state.t) / run.dt
+        self.announce(f"critical step {run.dt_critical:.4g}, step {run.dt:.4g}: about {steps:,.0f} steps to the end at "
+                      "this step; the time left, shown once the pace is known, follows the step as it changes "
+                      "(shellsim check forecasts the time)")
 
-    def _fields(self, run: Run) -> dict:
-        if _static(run):  # its last load step in place of the time step
+    def columns(self, run: Run) -> str:
+        """The status columns of ``run``'s path now."""
+        quality = "" if run.worst is None else f"  J/J0 {run.worst.ratio:.2f} (el. {run.worst.element + 1})"
+        if _static(run):  # its last load or time step in place of the explicit step
             step = run.newton[-1]
-            return {"t": f"{run.sim.state.t:.4g}", "dt": f"load step {len(run.newton)}", "rate": "-",
-                    "balance": f"{step.iterations} iterations ({step.tangents} tangents), residual {step.residual:.2g}",
-                    "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
+            kind = "time step" if run.deck.solver.method == "implicit" else "load step"
+            return (f"{kind} {len(run.newton)}: {step.iterations} iterations, {step.tangents} "
+                    f"tangent{'s' if step.tangents != 1 else ''}, residual {step.residual:.2g}{quality}")
         since, steps_then = self.stepping_since
         elapsed = max(time.perf_counter() - since, 1e-9)
         share = run.balance_share()
-        return {"t": f"{run.sim.state.t:.4g}", "dt": f"{run.dt:.3g}",
-                "rate": f"{(run.sim.state.steps - steps_then) / elapsed:,.0f}",
-                "balance": "-" if share is None else f"{100 * share:+.2f}%",
-                "quality": "-" if run.worst is None else f"{run.worst.ratio:.2f} (el. {run.worst.element + 1})"}
+        return (f"dt {run.dt:.3g}  {(run.sim.state.steps - steps_then) / elapsed:,.0f} steps/s  "
+                f"balance {'-' if share is None else f'{100 * share:+.2f}%'}{quality}")
 
     def on_sample(self, run: Run) -> None:
         if self.quiet:
             return
+        if not self.forecast_told and not _static(run) and run.dt:  # the explicit steps' start
+            self.forecast_told = True
+            self._forecast(run)
+        state = run.sim.state
+        self.pace.add(state.t, state.steps)
+        self.status = self.columns(run)
+        left = left_text(self.pace.left(self.end_time, None if _static(run) else run.dt))
         if self.bar is not None:
-            f = self._fields(run)
-            self.status = f"dt {f['dt']}  {f['rate']} steps/s  balance {f['balance']}  J/J0 {f['quality']}"
-            self.bar.update(self.task, completed=run.sim.state.t, t=f["t"], status=self.status)
-        elif run.sim.state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
-            f = self._fields(run)
-            done = f"t = {f['t']} ({100 * run.sim.state.t / self.end_time:.0f}%), "
-            self.console.print(done + (f"{f['dt']}: {f['balance']}" if _static(run) else
-                                       f"dt {f['dt']}, {f['rate']} steps/s, balance {f['balance']}, "
-                                       f"worst J/J0 {f['quality']}"), highlight=False)
+            self.bar.update(self.task, completed=state.t, t=f"{state.t:.4g}", status=self.status, left=left)
+        elif state.t >= self.next_line * self.end_time - 1e-12 * self.end_time:
+            self.console.print(f"t = {state.t:.4g} ({100 * state.t / self.end_time:.0f}%), {self.status}, {left}",
+                               highlight=False)
             self.next_line += 0.1
 
     def close(self) -> None:
         if self.bar is not None:
             self.bar.stop()
+
+
+class ProgressCallback(Listener):
+    """Progress for a function: ``report({"t", "end_time", "steps", "status"})`` at every
+    history sample, the status the ``display``'s (a quiet :class:`ProgressDisplay`'s)
+    columns."""
+
+    def __init__(self, report, display: ProgressDisplay):
+        self.report, self.display = report, display
+
+    def on_dt(self, run: Run) -> None:
+        self.display.on_dt(run)
+
+    def on_sample(self, run: Run) -> None:
+        self.report({"t": run.sim.state.t, "end_time": self.display.end_time, "steps": run.sim.state.steps,
+                     "status": self.display.columns(run)})

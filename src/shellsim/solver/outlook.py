@@ -62,6 +62,31 @@ def time_step(solver: Solver, dt_critical: float) -> float:
     return dt if solver.dt_max is None else min(dt, solver.dt_max)
 
 
+#: Wall time [s] the timing of a scene's own steps may take, and the fewest steps it times.
+TIMING_SECONDS, TIMED_STEPS = 0.3, 20
+
+
+def measured_step_seconds(deck: Deck, model: Model, dt: float, mass_factor: float = 1.0) -> float:
+    """The wall time [s] of one explicit step of ``model`` at ``dt`` (every mass times
+    ``mass_factor``), timed on the scene itself on a copy at rest: the compiled loop for TIMED_STEPS steps or TIMING_SECONDS,
+    and a warm critical-step estimate spread over the ``solver.dt_update_every`` steps
+    between estimates. Small scenes are bound by the estimates and the loop's own
+    overheads, not by their elements: on 3 to 19 elements the shipped decks took 160 to
+    980 us a step where a rate per element said 130."""
+    sim = Simulation(model)
+    sim.mass_factor = mass_factor
+    sim.update_masses()
+    sim.critical_time_step()
+    start = time.perf_counter()
+    sim.critical_time_step()  # warm, as the run's later estimates are
+    estimate = time.perf_counter() - start
+    sim.advance(math.inf, dt, 2)  # the first call may load the kernels
+    steps, start = 0, time.perf_counter()
+    while steps < TIMED_STEPS or time.perf_counter() - start < TIMING_SECONDS and steps < 100 * TIMED_STEPS:
+        steps += sim.advance(math.inf, dt, TIMED_STEPS)
+    return (time.perf_counter() - start) / steps + estimate / deck.solver.dt_update_every
+
+
 def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What the run's time step will be, before it starts: the critical step at t = 0
     [time] with each lumping, ``{"M1": .., "M2": ..}``; ``dt``, the step the run takes
@@ -79,15 +104,16 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
     if scaling is not None and dt < scaling.step:  # every mass scaled, the step the target
         mass_factor, dt = (scaling.step / dt) ** 2, scaling.step
     contact = contact_seconds(model, 0.0, initial)
-    steps, seconds = stepping(deck.solver.end_time, dt, model.n_elements, contact)
-    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": math.ceil(steps), "seconds": seconds,
-                       "contact_share": contact / (seconds_per_step(model.n_elements) + contact),
-                       "bytes": memory_bytes(model.n_elements)}
+    per_step = measured_step_seconds(deck, model._replace(mass=deck.solver.mass), dt, mass_factor)
+    steps = math.ceil(deck.solver.end_time / dt)
+    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": steps, "seconds": steps * per_step,
+                       "contact_share": contact / per_step, "bytes": memory_bytes(model.n_elements)}
 
 
 def static_outlook(model: Model) -> dict:
     """What a static or implicit solve will hold and cost per tangent: ``unknowns`` (5 DOF
-    per node, supports' included), ``seconds`` to form a tangent at rest and factorise it
+    per node, supports' included), ``residual_seconds`` to evaluate the residual once (an
+    iteration's main cost), ``seconds`` to form a tangent at rest and factorise it
     on this machine's threads (timed: the rate per element said 0.056 s where the aortic
     valve's tangent and factors took 0.22 s, the follower pressure's and the contact's
     tangents and the factors left out), ``bytes``."""
@@ -95,11 +121,42 @@ def static_outlook(model: Model) -> dict:
     equilibrium.evaluate(0.0)
     equilibrium.tangent()  # the first call may compile the kernels
     start = time.perf_counter()
+    equilibrium.evaluate(0.0)
+    residual = time.perf_counter() - start
+    start = time.perf_counter()
     tangent = equilibrium.tangent()
     with suppress(RuntimeError):  # singular at rest (a slack chord's nodes): the forming's time alone
         SymmetricPatternLU(tangent[:, :equilibrium.unknowns.n_free])
-    return {"unknowns": 5 * model.n_nodes, "seconds": time.perf_counter() - start,
+    return {"unknowns": 5 * model.n_nodes, "seconds": time.perf_counter() - start, "residual_seconds": residual,
             "bytes": memory_bytes(model.n_elements)}
+
+
+#: A Newton path's iterations and tangents per load or time step, as the shipped decks
+#: take them (benchmarks/forecasts.py): what its forecast counts on.
+ITERATIONS_PER_STEP, TANGENTS_PER_STEP = 8.0, 3.0
+
+
+def newton_steps(deck: Deck) -> int:
+    """About how many load or time steps a static or implicit solve takes: its
+    ``increments`` first, and at least one to each output time it lands on."""
+    from .run import output_times
+
+    settings = deck.solver.implicit if deck.solver.method == "implicit" else deck.solver.static
+    return max(settings.increments, len(output_times(deck)))
+
+
+def forecast(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+    """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
+    outlook they come from: :func:`step_outlook`'s for the explicit path, with the static
+    preload's steps added; :func:`static_outlook`'s for a Newton path, its time per
+    tangent as ``tangent_seconds``). A Newton step counts ITERATIONS_PER_STEP residuals
+    and TANGENTS_PER_STEP tangents, each timed on the scene at rest."""
+    if deck.solver.method == "explicit":
+        return step_outlook(deck, model, on_product)
+    outlook = static_outlook(model)
+    steps = newton_steps(deck)
+    per_step = TANGENTS_PER_STEP * outlook["seconds"] + ITERATIONS_PER_STEP * outlook["residual_seconds"]
+    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": outlook["seconds"]}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:

@@ -41,6 +41,32 @@ EXIT_INTERRUPTED = 130
 EXIT_TERMINATED = 143  # 128 + SIGTERM, as shells report it
 
 DeckPath = Annotated[Path, typer.Argument(help="Scene deck (TOML).", show_default=False)]
+DeckChanges = Annotated[list[str] | None, typer.Option(
+    "--set", help="Change a key of the deck for this run, KEY=VALUE with VALUE written as in TOML (repeat for "
+                  "more), e.g. --set solver.damping=300 --set 'solver.mass_scaling={step = 4e-5}'; [[tables]] "
+                  "by number from 0: contact.0.penalty=3. The run's deck.toml holds the result.")]
+
+
+def _scene(deck: Path, changes: list[str] | None):
+    """The deck at ``deck`` with the --set ``changes`` made, validated."""
+    import tomllib
+
+    from .deck import load_deck
+    from .study.jobs import variant_deck
+
+    if not changes:
+        return load_deck(deck)
+    overrides = {}
+    for change in changes:
+        key, _, value = change.partition("=")
+        try:
+            overrides[key.strip()] = tomllib.loads(f"value = {value}")["value"]
+        except tomllib.TOMLDecodeError:
+            raise typer.BadParameter(f"got '{change}'; expected KEY=VALUE with VALUE as in TOML: a number, true, "
+                                     "\"text\", [1, 2] or {key = 1}", param_hint="--set") from None
+        if not key.strip() or not value.strip():
+            raise typer.BadParameter(f"got '{change}'; expected KEY=VALUE", param_hint="--set")
+    return variant_deck(deck, overrides)
 
 
 @contextmanager
@@ -92,28 +118,24 @@ def main(
 
 @app.command()
 @reports_errors
-def check(deck: DeckPath) -> None:
+def check(deck: DeckPath, changes: DeckChanges = None) -> None:
     """Validate a deck, build its mesh, summarise the scene, and say what its time step and
     step count will be."""
-    from .deck import load_deck
     from .execute import sized_mesh
     from .geometry.crossings import crossing_problem
     from .model import build_model
     from .plan import plan
     from .loads import overlaps_at_rest
-    from .solver.outlook import refuse_if_hopeless, static_outlook, step_outlook
+    from .solver.outlook import forecast, refuse_if_hopeless
 
-    scene = load_deck(deck)
+    scene = _scene(deck, changes)
     mesh = sized_mesh(scene, deck.parent, lambda text: err.print(f"[dim]{shown(text)}[/]", highlight=False))
     newton_steps = scene.solver.method != "explicit"  # static or implicit: a tangent's cost
     with err.status("building the model") as status, _compiles_shown(status):
         model = build_model(scene, mesh)
-        if newton_steps:
-            outlook = static_outlook(model)
-        else:
-            status.update("estimating the critical time step")
-            outlook = step_outlook(scene, model, lambda count: status.update(
-                f"estimating the critical time step: {count} stiffness products"))
+        status.update("timing a tangent and a residual" if newton_steps else "estimating the critical time step")
+        outlook = forecast(scene, model, lambda count: status.update(
+            f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if not newton_steps:
         refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])
@@ -271,6 +293,7 @@ def run(
         "--resume", help="Go on from the checkpoint in a run's folder (output.checkpoint_interval), to its deck's "
                          "end.")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
+    changes: DeckChanges = None,
 ) -> None:
     """Run a scene: in time by explicit central differences, or as equilibria by Newton
     load steps (solver.method = "static"), or in time by implicit Newton steps (solver.method =
@@ -282,7 +305,6 @@ def run(
     check fails, 3 when the run goes unstable, 130 on Ctrl-C and 143 on SIGTERM (what was
     written stays readable; the summary says interrupted)."""
     from .compile_watch import watching_compiles
-    from .deck import load_deck
     from .deck.resolved import RESOLVED_NAME, read_resolved
     from .execute import run_scene
     from .output.checkpoint import read_checkpoint
@@ -295,10 +317,12 @@ def run(
     if resume is not None:
         if out_dir is not None:
             raise typer.BadParameter("a resumed run goes on in its own folder", param_hint="--out")
+        if changes:
+            raise typer.BadParameter("a resumed run goes on with the deck it was run with", param_hint="--set")
         checkpoint = read_checkpoint(resume)
         scene, deck, folder = read_resolved(resume), resume / RESOLVED_NAME, resume
     else:
-        checkpoint, scene = None, load_deck(deck)
+        checkpoint, scene = None, _scene(deck, changes)
         folder = output_folder(out_dir or Path("results") / deck.stem)  # before any work is done
     with claimed(folder):  # the renders too
         with closing(ProgressDisplay(out, scene.solver.end_time, quiet)) as progress, \
@@ -319,6 +343,7 @@ def run(
                 _announce(written)
     if not quiet:
         out.print(_run_report(result, folder))
+        out.print(_what_to_open(folder), highlight=False)
     if current.status in ("unstable", "not converged"):
         err.print(f"[bold red]error:[/] {shown(message)}", highlight=False)
         raise typer.Exit(EXIT_UNSTABLE)
@@ -356,6 +381,32 @@ def _run_report(result: dict, folder: Path) -> Table | str:
                       f"{r['expected']:.6g}", error, tolerance,
                       {True: "[green]yes", False: "[red]no", None: "-"}[r["passed"]])
     return table
+
+
+def _what_to_open(folder: Path) -> str:
+    """The closing lines: where the results are and what to open them with."""
+    series = [name for name in ("results.xdmf", "results.pvd") if (folder / name).exists()]
+    lines = [f"results in {shown(str(folder))}/:"]
+    if series:
+        lines.append(f"  paraview {shown(str(folder / series[0]))}   every frame at its time (ParaView 5.11 or newer)")
+    if (folder / "renders").is_dir():
+        lines.append(f"  {shown(str(folder / 'renders'))}/   the deck's pictures; shellsim render {shown(str(folder))} "
+                     "--field F for others")
+    lines.append(f"  shellsim plot {shown(str(folder))}   the probes' histories, against the load too, with the "
+                 "references; history.csv holds them as numbers")
+    return "\n".join(lines)
+
+
+def _newton_cost(outlook: dict) -> str:
+    """The cost row of a static or implicit solve (:func:`shellsim.solver.outlook.forecast`)."""
+    from .memory import size_text
+    from .solver.outlook import ITERATIONS_PER_STEP, TANGENTS_PER_STEP, duration
+
+    return (f"{outlook['unknowns']:,} unknowns; about {outlook['steps']:,} steps and {duration(outlook['seconds'])} "
+            f"on this machine (at {ITERATIONS_PER_STEP:g} iterations and {TANGENTS_PER_STEP:g} tangents a step, "
+            f"the shipped decks' mean: {duration(outlook['tangent_seconds'])} a tangent, "
+            f"{duration(outlook['residual_seconds'])} a residual, timed at rest; a stiffening or contacting scene "
+            f"takes more), {size_text(outlook['bytes'])} of memory")
 
 
 def _frame_choice(value: str) -> str | int:
@@ -628,15 +679,13 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
         row("solver", f"static: {steps} t = {sv.end_time}, {st.increments} "
                                 f"first, at most {st.max_iterations} iterations each, tolerances force "
                                 f"{st.force_tolerance:g}, energy {st.energy_tolerance:g}")
-        row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
-                              f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
+        row("cost", _newton_cost(outlook))
     elif sv.method == "implicit":
         im = sv.implicit
         row("solver", f"implicit dynamics (HHT, alpha {im.alpha:g}) to t = {sv.end_time} in {im.increments} time "
                       f"steps first ({im.newton} Newton, at most {im.max_iterations} iterations each), mass {sv.mass}"
                       + (f", damping {sv.damping}/s" if sv.damping else ""))
-        row("cost", f"{outlook['unknowns']:,} unknowns; about {duration(outlook['seconds'])} per "
-                    f"tangent on this machine, {size_text(outlook['bytes'])} of memory")
+        row("cost", _newton_cost(outlook))
     else:
         if sv.preload is not None:
             row("preload", f"static load steps to t = {sv.preload} ({sv.static.increments} first), "

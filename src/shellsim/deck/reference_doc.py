@@ -35,18 +35,42 @@ def _tag(cls: type[BaseModel]) -> str:
     return tag_of(cls)[1]
 
 
-def _default(field) -> str:
+def _toml(value) -> str:
+    """A default as a deck writes it: "text", true, [1.0, 2.0], { key = 1 }."""
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(map(_toml, value)) + "]"
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }" if value else "{}"
+    return repr(value)
+
+
+def _default(field, name: str, heading: str) -> str:
     if field.default is PydanticUndefined and field.default_factory is None:
         return "required"
     value = field.default_factory() if field.default_factory is not None else field.default
-    return f"`{value!r}`"
+    table = f"[{heading.strip('#[] ')}.{name}]"
+    if isinstance(value, BaseModel):
+        return f"the table `{table}` below, each key defaulted"
+    if value is None and _subtable(field) is not None:
+        return f"none: off unless `{table}` (below) is given"
+    return "none" if value is None else f"`{_toml(value)}`"
+
+
+def _subtable(field) -> type[BaseModel] | None:
+    """The table class an optional key takes (``MassScaling | None``), or None."""
+    arguments = getattr(field.annotation, "__args__", ())
+    return next((a for a in arguments if isinstance(a, type) and issubclass(a, BaseModel)), None)
 
 
 def _table(cls: type[BaseModel], heading: str, skip_tag: bool = False) -> list[str]:
     rows = [f"{heading}", "", inspect.cleandoc(cls.__doc__ or ""), "", "| key | default |", "|---|---|"]
     tag = tag_of(cls)
     names = [n for n in cls.model_fields if not (skip_tag and tag and n == tag[0])]
-    rows += [f"| `{name}` | {_default(cls.model_fields[name])} |" for name in names]
+    rows += [f"| `{name}` | {_default(cls.model_fields[name], name, heading)} |" for name in names]
     return rows + [""]
 
 
@@ -90,8 +114,9 @@ def deck_reference() -> str:
         lines += _table(cls, f'#### model = "{_tag(cls)}"', skip_tag=True)
     lines += _table(Curve, "## [curves.NAME]")
     lines += _table(schema.Solver, "## [solver]")
-    lines += _table(schema.Static, "### [solver.static]")
-    lines += _table(schema.Implicit, "### [solver.implicit]")
+    for name in ("static", "implicit", "mass_scaling", "relaxation", "imaged"):
+        field = schema.Solver.model_fields[name]
+        lines += _table(_subtable(field) or type(field.default), f"### [solver.{name}]")
     lines += _table(schema.Output, "## [output]")
     lines += _table(schema.Render, "## [[output.render]]")
     for family in FAMILIES:

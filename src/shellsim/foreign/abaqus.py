@@ -718,7 +718,8 @@ class _Builder:
                 self.model.unmapped.append(
                     f"{k.label()}: PRESSURE-OVERCLOSURE={overclosure.upper()} ({constants or 'no constants'}) is not "
                     "carried: shellsim's contact is a penalty scaled to each node's critical-step spring "
-                    "(contact.penalty, 0.1 by default: stiff, near HARD); the contact stays with that")
+                    "(contact.penalty, 0.1 by default); soft leaflets pressed by a full pressure sink into "
+                    "each other at 0.1, and closed with 1 to 3 (docs/start-import.md)")
             elif k.name == "contact damping":
                 self.model.unmapped.append(f"{k.label()}: *CONTACT DAMPING is not carried (shellsim's contact has no "
                                            "damping of its own)")

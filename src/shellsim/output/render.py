@@ -284,7 +284,8 @@ def render_field(folder: Path, field: str = "pressure_band", frame: str | int = 
     picked = [(_finite_or_missing(units.scale(field) * values), on_cells, part)
               for values, on_cells, part in (field_values(p, c, field, component) for p, c in frames)]
     limits = colour_limits([v for v, _, _ in picked], scale, units.unit(field))
-    label = field.removesuffix(NODAL_SUFFIX).replace("_", " ") + (", nodal" if field.endswith(NODAL_SUFFIX) else "")
+    label = (field.removesuffix(NODAL_SUFFIX).replace("_", " ").replace("von mises", "von Mises")
+             + (", nodal" if field.endswith(NODAL_SUFFIX) else ""))
     part = picked[0][2]  # a tensor's component as files and ParaView name it: XZ, not zx
     bar = units.label(f"{label} {''.join(sorted(part)).upper() if part in TENSOR_COLUMNS else part}".strip(), field)
     out_dir = output_folder(out_dir or refuse_link(folder / RENDERS_DIR))
@@ -418,7 +419,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
         segments = np.column_stack([np.full(len(ends), 2), ends]).ravel()
         plotter.add_mesh(pv.PolyData(at, lines=segments), color=CABLE_COLOUR, line_width=3)
         points = np.vstack([points, at])  # the view takes them in
-    plotter.add_text(caption, position="upper_left", font_size=max(7, size[1] // 80), color="black")
+    plotter.add_text(caption, position="upper_left", font_size=max(9, size[1] // 70), color="black")
     _look(plotter, view, points, FIELD_MARGINS)
     try:
         with replacing(path) as partial:

@@ -206,3 +206,28 @@ def test_durations_read_as_a_person_writes_them():
 
     assert [duration(s) for s in (3.24, 108.4, 840.0, 5.1 * 3600, 3 * 86400)] == \
         ["3.2 s", "108 s", "14 min", "5.1 h", "3 days"]
+
+
+def test_set_changes_a_deck_for_one_run_and_says_what_it_expects(tmp_path):
+    """--set KEY=VALUE (a TOML value; [[tables]] by number) changes the deck for one run,
+    whose deck.toml keeps the change while the deck file stays as it was; a VALUE that is
+    no TOML, a key without a value, a change the deck's model refuses and a change with
+    --resume are errors naming what was expected."""
+    import tomllib
+
+    deck = ROOT / "decks" / "verification" / "test02_cantilever_uniform_load_3_static.toml"
+    shipped = deck.read_text()
+    result = runner.invoke(app, ["run", str(deck), "--out", str(tmp_path / "out"), "--quiet",
+                                 "--set", "solver.end_time=0.5", "--set", "boundary.0.set=\"x0\"",
+                                 "--set", "output.fields=[\"displacement\", \"von_mises\"]"])
+    assert result.exit_code in (0, 1), result.output  # 1: the reference is the whole load's
+    resolved = tomllib.loads((tmp_path / "out" / "deck.toml").read_text())
+    assert resolved["solver"]["end_time"] == 0.5 and resolved["output"]["fields"] == ["displacement", "von_mises"]
+    assert deck.read_text() == shipped
+    for change, expected in (("solver.end_time=half", "expected KEY=VALUE with VALUE as in TOML"),
+                             ("solver.end_time=", "expected KEY=VALUE"),
+                             ("solver.end_time=-1", "solver.end_time")):
+        result = runner.invoke(app, ["check", str(deck), "--set", change])
+        assert result.exit_code != 0 and expected in " ".join(result.output.split()), (change, result.output)
+    result = runner.invoke(app, ["run", "--resume", str(tmp_path / "out"), "--set", "solver.end_time=1"])
+    assert result.exit_code != 0 and "with the deck it was run with" in " ".join(result.output.split())

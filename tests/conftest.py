@@ -53,7 +53,8 @@ def pytest_configure(config):
 
         start = time.perf_counter()
         compiled = []
-        note = "compiling the kernels of three scenes, once for this version: about a minute and a half on 2 idle cores"
+        note = ("compiling the kernels of three scenes, once for this version: about a minute and a half on 2 idle "
+                "cores, several times that on a busy machine")
         with watching_compiles(lambda name: compiled or print(note, flush=True),
                                lambda name, seconds: compiled.append(name)):
             warm_numba_cache()

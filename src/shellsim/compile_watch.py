@@ -17,7 +17,8 @@ from numba.core import event
 #: What a user is told when a scene's kernels compile: once per version, and how long for
 #: a first scene from an empty cache (docs/verification.md; a later scene with other load
 #: or contact kinds compiles its own time loop, a fraction of that).
-FIRST_RUN_NOTE = "once for this version of shellsim: about half a minute for a first scene on 2 idle cores"
+FIRST_RUN_NOTE = ("once for this version of shellsim: about half a minute for a first scene on 2 idle cores, "
+                  "several times that on a busy machine; later runs load them")
 #: Kernels that compile longer than this [s] are named when done; the rest pass quietly.
 WORTH_TELLING = 5.0
 

@@ -400,11 +400,12 @@ def _what_to_open(folder: Path) -> str:
 def _newton_cost(outlook: dict) -> str:
     """The cost row of a static or implicit solve (:func:`shellsim.solver.outlook.forecast`)."""
     from .memory import size_text
-    from .solver.outlook import ITERATIONS_PER_STEP, TANGENTS_PER_STEP, duration
+    from .solver.outlook import duration
 
+    iterations, tangents = outlook["pace"]
     return (f"{outlook['unknowns']:,} unknowns; about {outlook['steps']:,} steps and {duration(outlook['seconds'])} "
-            f"on this machine (at {ITERATIONS_PER_STEP:g} iterations and {TANGENTS_PER_STEP:g} tangents a step, "
-            f"the shipped decks' mean: {duration(outlook['tangent_seconds'])} a tangent, "
+            f"on this machine (at {iterations:g} iterations and {tangents:g} tangents a step, as the shipped decks "
+            f"took them: {duration(outlook['tangent_seconds'])} a tangent, "
             f"{duration(outlook['residual_seconds'])} a residual, timed at rest; a stiffening or contacting scene "
             f"takes more), {size_text(outlook['bytes'])} of memory")
 

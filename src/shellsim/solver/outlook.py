@@ -80,11 +80,16 @@ def measured_step_seconds(deck: Deck, model: Model, dt: float, mass_factor: floa
     start = time.perf_counter()
     sim.critical_time_step()  # warm, as the run's later estimates are
     estimate = time.perf_counter() - start
-    sim.advance(math.inf, dt, 2)  # the first call may load the kernels
+    end = deck.solver.end_time  # a finite stop: toward an infinite one each step took 50 times as long
+    sim.advance(end, dt, 2)  # the first call may load the kernels
     steps, start = 0, time.perf_counter()
     while steps < TIMED_STEPS or time.perf_counter() - start < TIMING_SECONDS and steps < 100 * TIMED_STEPS:
-        steps += sim.advance(math.inf, dt, TIMED_STEPS)
-    return (time.perf_counter() - start) / steps + estimate / deck.solver.dt_update_every
+        taken = sim.advance(end, dt, TIMED_STEPS)
+        if not taken:  # at the end already (a scene of a few steps)
+            break
+        steps += taken
+    loop = (time.perf_counter() - start) / steps if steps else 0.0
+    return loop + estimate / deck.solver.dt_update_every
 
 
 def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
@@ -131,32 +136,48 @@ def static_outlook(model: Model) -> dict:
             "bytes": memory_bytes(model.n_elements)}
 
 
-#: A Newton path's iterations and tangents per load or time step, as the shipped decks
-#: take them (benchmarks/forecasts.py): what its forecast counts on.
-ITERATIONS_PER_STEP, TANGENTS_PER_STEP = 8.0, 3.0
+#: Each Newton path's (iterations, tangents) per load or time step, as the shipped decks
+#: took them on average (benchmarks/forecasts.py): load control 7.8-11.5 iterations and
+#: 0.3-3 tangents (the carotid, the cantilever), arc length 2.3-3.2 and 1.9-2.7 (the
+#: balloon, the hinged roofs), implicit 10.9 and 3.6 (the aortic valve).
+NEWTON_PACE = {"load": (8.0, 1.0), "arc_length": (3.0, 3.0), "implicit": (11.0, 3.6)}
+#: Arc length takes about this many steps per output landing or first increment (the
+#: hinged roofs 1.8 and 2.0, the balloon 4.1).
+ARC_STEPS = 2.0
+#: An iteration's own bookkeeping beyond its residual [s]: a 3-element cantilever's 31
+#: iterations took 0.12 s.
+ITERATION_SECONDS = 3e-3
+
+
+def newton_path(deck: Deck) -> str:
+    """The Newton path of a static or implicit deck: "load", "arc_length" or "implicit"."""
+    return "implicit" if deck.solver.method == "implicit" else deck.solver.static.control
 
 
 def newton_steps(deck: Deck) -> int:
     """About how many load or time steps a static or implicit solve takes: its
-    ``increments`` first, and at least one to each output time it lands on."""
+    ``increments`` first, and at least one to each output time it lands on; arc length
+    ARC_STEPS times that."""
     from .run import output_times
 
     settings = deck.solver.implicit if deck.solver.method == "implicit" else deck.solver.static
-    return max(settings.increments, len(output_times(deck)))
+    steps = max(settings.increments, len(output_times(deck)))
+    return math.ceil(steps * (ARC_STEPS if newton_path(deck) == "arc_length" else 1.0))
 
 
 def forecast(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
-    outlook they come from: :func:`step_outlook`'s for the explicit path, with the static
-    preload's steps added; :func:`static_outlook`'s for a Newton path, its time per
-    tangent as ``tangent_seconds``). A Newton step counts ITERATIONS_PER_STEP residuals
-    and TANGENTS_PER_STEP tangents, each timed on the scene at rest."""
+    outlook they come from: :func:`step_outlook`'s for the explicit path; for a Newton
+    path :func:`static_outlook`'s, its time per tangent as ``tangent_seconds``, and the
+    iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``)."""
     if deck.solver.method == "explicit":
         return step_outlook(deck, model, on_product)
     outlook = static_outlook(model)
     steps = newton_steps(deck)
-    per_step = TANGENTS_PER_STEP * outlook["seconds"] + ITERATIONS_PER_STEP * outlook["residual_seconds"]
-    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": outlook["seconds"]}
+    iterations, tangents = pace = NEWTON_PACE[newton_path(deck)]
+    per_step = tangents * outlook["seconds"] + iterations * (outlook["residual_seconds"] + ITERATION_SECONDS)
+    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": outlook["seconds"],
+                      "pace": pace}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:

@@ -67,12 +67,13 @@ class Pace:
     def left(self, end_time: float, dt: float | None) -> tuple[float, float] | None:
         """(soonest, latest) seconds to ``end_time`` at the recent pace, the step ``dt`` on
         (explicit) or None (Newton steps); None while it is not known."""
-        pairs = list(zip(self.samples, self.samples[1:]))
-        to_go = end_time - self.samples[-1][1] if self.samples else 0.0
+        if not self.samples:
+            return None
+        to_go = end_time - self.samples[-1][1]
         if dt:
-            (w0, _, n0), (w1, _, n1) = (self.samples[0], self.samples[-1]) if pairs else ((0, 0, 0),) * 2
-            return ((to_go / dt * (w1 - w0) / (n1 - n0),) * 2) if n1 > n0 else None
-        rates = [(b[0] - a[0]) / (b[1] - a[1]) for a, b in pairs if b[1] > a[1]]
+            (w0, _, n0), (w1, _, n1) = self.samples[0], self.samples[-1]
+            return (to_go / dt * (w1 - w0) / (n1 - n0),) * 2 if n1 > n0 else None
+        rates = [(b[0] - a[0]) / (b[1] - a[1]) for a, b in zip(self.samples, self.samples[1:]) if b[1] > a[1]]
         return tuple(to_go * np.percentile(rates, [25, 75])) if rates else None  # the middle half of the rates
 
 
@@ -133,8 +134,8 @@ class ProgressDisplay(Listener):
             self.announce(text)
 
     def on_dt(self, run: Run) -> None:
-        """At the start (the estimates at t = 0, a mass scaling's among them): the step and
-        what the run will cost, said once the last of them is in (at the first sample)."""
+        """At the start (the estimates at t = 0, a mass scaling's among them): the steps'
+        rate counts from here, not from the compiling before."""
         if run.sim.state.t == 0.0:
             self.stepping_since = (time.perf_counter(), run.sim.state.steps)  # not the compiling before
 

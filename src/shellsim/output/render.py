@@ -391,7 +391,7 @@ def _render_frame(points: np.ndarray, series, colouring: Colouring, view: str, s
                          "position_y": 0.02, "width": 0.6, "height": 0.12, "n_labels": 5,
                          "title_font_size": max(10, size[1] // 40), "label_font_size": max(8, size[1] // 50)})
     field_actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()  # lines on the surface drawn in front
-    plotter.scalar_bar.SetTextPositionToPrecedeScalarBar()  # ticks below the bar, its title above: apart
+    plotter.scalar_bar.SetTextPositionToPrecedeScalarBar()  # the tick labels under the bar, its title under them
     rings = np.arange(0, len(points), 16)[:, None] + ELEMENT_RING[None]
     lines = np.hstack([np.full((len(rings), 1), len(ELEMENT_RING)), rings]).ravel()
     plotter.add_mesh(pv.PolyData(points, lines=lines), color="black", line_width=2)

@@ -315,7 +315,11 @@ class Solver(Section):
     "explicit"``, the default), static equilibrium by Newton-Raphson load steps over
     the pseudo-time 0 to ``end_time`` (``method = "static"``, settings in
     ``[solver.static]``), or implicit dynamics by Newton-Raphson time steps (``method =
-    "implicit"``, settings in ``[solver.implicit]``).
+    "implicit"``, settings in ``[solver.implicit]``). Which to choose: slow loading
+    without contact (a vessel's pressure) is static; a valve of a few thousand shells
+    closing under contact, implicit; 10^3 to 10^4 shells with chordae and self-contact,
+    explicit with ``mass_scaling`` throughout and ``damping``; waves and impacts,
+    explicit (docs/start-valve.md gives the costs measured on the valves).
 
     Δt = Δt_critical / ``dt_safety_factor`` (thesis Eq 3.43; LS-DYNA's TSSFAC is its
     inverse), Δt_critical re-estimated at least every ``dt_update_every`` steps, and more

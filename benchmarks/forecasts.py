@@ -4,9 +4,11 @@ then took, run as shipped in this process (kernels compiled before the first). P
 Markdown table, the ratios measured over forecast; nothing is asserted. Run it on an
 idle machine: the forecast's rates are an idle machine's.
 
-    .venv/bin/python benchmarks/forecasts.py [DECK ...] [--skip NAME ...] [--json FILE]
+    .venv/bin/python benchmarks/forecasts.py [DECK ...] [--skip NAME ...] [--json FILE] [--runs FILE]
 
-Without decks: every deck under decks/ but the studies' and the bench's.
+Without decks: every deck under decks/ but the studies' and the bench's. ``--runs FILE``
+takes each deck's run from the rows of an earlier ``--json FILE`` instead of running it
+again (a forecast changed, the runs not).
 """
 
 from __future__ import annotations
@@ -27,21 +29,24 @@ def shipped() -> list[Path]:
     return sorted(p for p in (ROOT / "decks").rglob("*.toml") if p.parent.name not in ("studies", "bench"))
 
 
-def measured(deck: Path) -> dict:
-    """The forecast and the run's own numbers for ``deck``, run as shipped without its renders."""
+def measured(deck: Path, earlier: dict | None = None) -> dict:
+    """The forecast and the run's own numbers for ``deck``, run as shipped without its
+    renders, or taken from ``earlier`` (a row of an earlier run of this script)."""
     from shellsim.study.jobs import variant_deck
 
     run = built_run(variant_deck(deck, {"output.render": []}), deck.parent)
     ahead = forecast(run.deck, run.model)
+    row = {"deck": str(deck.relative_to(ROOT)), "method": run.deck.solver.method, "elements": run.model.n_elements,
+           "forecast_steps": ahead["steps"], "forecast_s": ahead["seconds"], "tangent_s": ahead.get("tangent_seconds")}
+    if earlier is not None:
+        return earlier | row
     start = time.perf_counter()
     solve(run)
     wall = time.perf_counter() - start
     newton = run.newton
-    return {"deck": str(deck.relative_to(ROOT)), "method": run.deck.solver.method, "status": run.status,
-            "elements": run.model.n_elements, "forecast_steps": ahead["steps"], "forecast_s": ahead["seconds"],
-            "steps": int(run.sim.state.steps), "wall_s": wall,
-            "iterations": sum(step.iterations for step in newton), "tangents": sum(step.tangents for step in newton),
-            "tangent_s": ahead.get("tangent_seconds")}
+    return row | {"status": run.status, "steps": int(run.sim.state.steps), "wall_s": wall,
+                  "iterations": sum(step.iterations for step in newton),
+                  "tangents": sum(step.tangents for step in newton)}
 
 
 def table(rows: list[dict]) -> str:
@@ -59,11 +64,16 @@ def main() -> None:
     parser.add_argument("decks", nargs="*", type=Path)
     parser.add_argument("--skip", nargs="*", default=[], help="leave out decks whose path holds any of these")
     parser.add_argument("--json", type=Path, help="also write each row as a JSON line here")
+    parser.add_argument("--runs", type=Path, help="take the runs from this earlier --json file's rows")
     args = parser.parse_args()
     decks = [p.resolve() for p in args.decks] or [p for p in shipped() if not any(s in str(p) for s in args.skip)]
+    earlier = {}
+    if args.runs:
+        earlier = {row["deck"]: row for row in map(json.loads, args.runs.read_text(encoding="utf-8").splitlines())}
+        decks = [deck for deck in decks if str(deck.relative_to(ROOT)) in earlier]
     rows = []
     for deck in decks:
-        row = measured(deck)
+        row = measured(deck, earlier.get(str(deck.relative_to(ROOT))))
         rows.append(row)
         print(json.dumps(row), flush=True)
         if args.json:

@@ -231,3 +231,22 @@ def test_set_changes_a_deck_for_one_run_and_says_what_it_expects(tmp_path):
         assert result.exit_code != 0 and expected in " ".join(result.output.split()), (change, result.output)
     result = runner.invoke(app, ["run", "--resume", str(tmp_path / "out"), "--set", "solver.end_time=1"])
     assert result.exit_code != 0 and "with the deck it was run with" in " ".join(result.output.split())
+
+
+def test_a_newton_path_is_forecast_a_step_per_output_time_or_its_increments():
+    """A static solve lands on every output time: at least one load step to each, or its
+    increments where more; arc length twice that; implicit its time steps' increments."""
+    from shellsim.deck import parse_deck
+    from shellsim.solver.outlook import newton_path, newton_steps
+
+    plate = deck_text('builder = "rectangle"\nlength = 2.0\nwidth = 1.0')
+    static = plate.replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "static"\nend_time = 1.0')
+    landing = parse_deck(static + "\n[output]\ninterval = 0.25\ntimes = [0.1]\n")
+    assert newton_path(landing) == "load" and newton_steps(landing) == 5  # 0.1, 0.25, 0.5, 0.75, 1
+    more = parse_deck(static.replace('method = "static"', 'method = "static"\nstatic = { increments = 10 }'))
+    assert newton_steps(more) == 10
+    arc = parse_deck(static.replace('method = "static"', 'method = "static"\nstatic = { control = "arc_length", '
+                                                         'increments = 10 }'))
+    assert newton_path(arc) == "arc_length" and newton_steps(arc) == 20
+    implicit = parse_deck(plate.replace("[solver]\nend_time = 1.0", '[solver]\nmethod = "implicit"\nend_time = 1.0'))
+    assert newton_path(implicit) == "implicit" and newton_steps(implicit) == 100

@@ -59,13 +59,13 @@ def _scene(deck: Path, changes: list[str] | None):
     overrides = {}
     for change in changes:
         key, _, value = change.partition("=")
+        if not key.strip() or not value.strip():
+            raise typer.BadParameter(f"got '{change}'; expected KEY=VALUE", param_hint="--set")
         try:
             overrides[key.strip()] = tomllib.loads(f"value = {value}")["value"]
         except tomllib.TOMLDecodeError:
             raise typer.BadParameter(f"got '{change}'; expected KEY=VALUE with VALUE as in TOML: a number, true, "
                                      "\"text\", [1, 2] or {key = 1}", param_hint="--set") from None
-        if not key.strip() or not value.strip():
-            raise typer.BadParameter(f"got '{change}'; expected KEY=VALUE", param_hint="--set")
     return variant_deck(deck, overrides)
 
 

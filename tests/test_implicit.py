@@ -69,7 +69,8 @@ def test_a_slack_cable_falls_to_the_exact_elastic_catenary_where_a_static_solve_
 
 def test_check_times_a_tangent_and_its_factors_for_the_implicit_path(tmp_path):
     """``check`` of the plate as an implicit deck forms a tangent at rest and factorises
-    it, and says how long that took on this machine, beside the unknowns (5 per node)."""
+    it, and says how long that took on this machine and what the steps will take at the
+    implicit path's iterations and tangents a step, beside the unknowns (5 per node)."""
     import re
 
     from typer.testing import CliRunner
@@ -84,4 +85,5 @@ def test_check_times_a_tangent_and_its_factors_for_the_implicit_path(tmp_path):
     said = " ".join(result.output.replace("│", " ").split())
     assert result.exit_code == 0, result.output
     unknowns = 5 * len(build_mesh(parse_deck(text)).x)
-    assert re.search(rf"{unknowns:,} unknowns; about [\d.e+-]+ (s|min|h) per tangent on this machine", said), said
+    assert re.search(rf"{unknowns:,} unknowns; about [\d,]+ steps and [\d.e+-]+ (s|min|h) on this machine \(at 11 "
+                     r"iterations and 3.6 tangents a step.*: [\d.e+-]+ (s|min|h) a tangent", said), said

@@ -82,12 +82,12 @@ def test_the_closed_valve_s_measures_are_a_closed_valve_s(closing):
 
 
 def test_the_closed_valve_is_drawn_with_its_contact_pressure_and_stress_and_its_measures_plotted(closing):
-    """The deck's renders (contact pressure from the top, von Mises iso) and `shellsim
+    """The deck's renders (contact pressure from the side, von Mises iso) and `shellsim
     plot`'s picture of each valve measure against time, drawn from the samples measured."""
     from shellsim.output.plots import plot_run
 
     run, folder = closing
-    renders = {p.name.split("_top")[0].split("_iso")[0] for p in (folder / "renders").glob("*.png")}
+    renders = {p.name.split("_side")[0].split("_iso")[0] for p in (folder / "renders").glob("*.png")}
     assert {"contact_pressure", "von_mises"} <= renders
     written = {p.name for p in plot_run(folder)}
     assert {f"{column}.png" for column in run.deck.output.valve.COLUMNS} <= written

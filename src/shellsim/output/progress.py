@@ -32,15 +32,14 @@ class _Clock(ProgressColumn):
         since = task.fields["compiling_since"]
         if since is None:
             return Text(task.fields["left"], style="progress.remaining")
-        seconds = int(time.perf_counter() - since)
-        return Text(f"compiling {seconds // 60}:{seconds % 60:02d}", style="progress.elapsed")
+        return Text(f"compiling {clock(int(time.perf_counter() - since))}", style="progress.elapsed")
 
 
 def clock(seconds: float) -> str:
     """'0:42', '12:05', '3:02:10'."""
-    seconds = int(round(seconds))
-    hours, rest = divmod(seconds, 3600)
-    return (f"{hours}:" if hours else "") + (f"{rest // 60:02d}" if hours else f"{rest // 60}") + f":{rest % 60:02d}"
+    minutes, seconds = divmod(int(round(seconds)), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{seconds:02d}" if hours else f"{minutes}:{seconds:02d}"
 
 
 class Pace:

@@ -40,11 +40,12 @@ def seconds_per_step(n_elements: int) -> float:
     return SECONDS_PER_GROUP_STEP * groups / min(groups, max(1, get_num_threads()))
 
 
-def stepping(end_time: float, dt: float, n_elements: int, contact: float = 0.0) -> tuple[float, float]:
+def stepping(end_time: float, dt: float, n_elements: int) -> tuple[float, float]:
     """(steps, seconds): how many steps of ``dt`` reach ``end_time`` and about how long they
-    take, each ``contact`` seconds more for the contacts' forces (:func:`contact_seconds`)."""
+    take at SECONDS_PER_GROUP_STEP (a bound for refusing a hopeless scene; a forecast
+    times the scene itself, :func:`forecast`)."""
     steps = min(end_time / dt, 1e300)
-    return steps, steps * (seconds_per_step(n_elements) + contact)
+    return steps, steps * seconds_per_step(n_elements)
 
 
 def contact_seconds(model: Model, t: float, shape: Shape) -> float:

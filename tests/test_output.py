@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 from shellsim.cli import app, sigterm_as_interrupt
 from shellsim.deck import load_deck, parse_deck
 from shellsim.element.shape import gauss_rule
-from shellsim.errors import OutputError
+from shellsim.errors import OutputError, Terminated
 from shellsim.output.encoding import Encoding, symmetric_tensors
 from shellsim.output.fields import CORNER_RS, SUB_BOUNDS, frame_fields, output_mesh
 from shellsim.output.series import check_space
@@ -497,6 +497,43 @@ def test_a_stop_during_a_frame_lands_after_the_whole_frame_is_written_and_counte
     assert run.status == "interrupted"
     assert listener.parts == ["first", "second"] * 2
     assert len(run.frame_times) == 2
+
+
+class _StopSwallowedByACompiledCall(Listener):
+    """At the second sample the signal ``stop`` lands, and its KeyboardInterrupt turns into
+    another error, as when it lands while numba converts a compiled call's arguments."""
+
+    def __init__(self, stop):
+        self.stop = stop
+        self.samples = 0
+
+    def on_sample(self, run):
+        self.samples += 1
+        if self.samples == 2:
+            try:
+                os.kill(os.getpid(), self.stop)
+            except KeyboardInterrupt:
+                raise TypeError("can't unbox a <class 'numba.typed.typedlist.List'> as a <NULL>") from None
+
+
+@pytest.mark.parametrize(("stop", "stopped"), [(signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, Terminated)],
+                         ids=["ctrl-c", "sigterm"])
+def test_a_stop_that_a_compiled_call_turns_into_another_error_still_stops_the_run(stop, stopped, ctrl_c_delivered):
+    run = prepared(parse_deck(PLATE))
+    with pytest.raises(stopped), sigterm_as_interrupt([]):
+        integrate(run, _StopSwallowedByACompiledCall(stop))
+    assert run.status == "interrupted"
+
+
+def test_an_error_without_a_stop_stays_that_error(ctrl_c_delivered):
+    class Failing(Listener):
+        def on_sample(self, run):
+            raise TypeError("a fault of the code")
+
+    run = prepared(parse_deck(PLATE))
+    with pytest.raises(TypeError, match="a fault of the code"):
+        integrate(run, Failing())
+    assert run.status == "running"
 
 
 @pytest.mark.parametrize("tolerance", ["tolerance = 1e-3", "tolerance_percent = 5.0"])

@@ -25,7 +25,7 @@ from ..mesh import Mesh
 from ..model import Model
 from ..measures import Measure, resolve_measures
 from .relaxation import Relaxing
-from ..signals import STOP_SIGNALS, handling
+from ..signals import STOP_SIGNALS, handling, noting_stops
 from .explicit import DAMPED, EXTERNAL, FRICTION, INTERNAL, KINETIC, equal_step
 from .outlook import refuse_if_hopeless, time_step
 from .quality import ElementQuality, Worst, folding_diagnosis, step_history
@@ -481,10 +481,12 @@ def ending(run: Run, listener: Listener, broken: str, cause: Callable[[Run], str
     """The block solves ``run`` (yielding its start time): its status as it ends
     ('completed'; 'refused', SceneTooLarge; ``broken``, NumericalError, whose message gains
     ``cause(run)`` after the breaking state is kept as a frame; 'interrupted',
-    KeyboardInterrupt, each raised on) and its wall time, however it ends."""
+    KeyboardInterrupt, each raised on) and its wall time, however it ends. Any other error
+    raised after a stop signal arrived is that stop, and is raised as the stop again."""
     start = time.perf_counter()
     try:
-        yield start
+        with noting_stops() as stops:
+            yield start
         run.status = "completed"
     except SceneTooLarge:
         run.status = "refused"
@@ -495,6 +497,12 @@ def ending(run: Run, listener: Listener, broken: str, cause: Callable[[Run], str
         raise NumericalError(f"{error}{cause(run)}") from None
     except KeyboardInterrupt:
         run.status = "interrupted"
+        raise
+    except Exception:
+        if not stops:
+            raise
+        run.status = "interrupted"
+        signal.raise_signal(stops[-1])  # its handler raises the stop's own exception
         raise
     finally:
         run.wall_time += time.perf_counter() - start  # a preloaded run's phases add up

@@ -35,7 +35,7 @@ def measured(deck: Path, earlier: dict | None = None) -> dict:
     from shellsim.study.jobs import variant_deck
 
     run = built_run(variant_deck(deck, {"output.render": []}), deck.parent)
-    ahead = forecast(run.deck, run.model)
+    ahead = forecast(run.deck, run.mesh, run.model)
     row = {"deck": str(deck.relative_to(ROOT)), "method": run.deck.solver.method, "elements": run.model.n_elements,
            "forecast_steps": ahead["steps"], "forecast_s": ahead["seconds"], "tangent_s": ahead.get("tangent_seconds")}
     if earlier is not None:

@@ -30,13 +30,14 @@ def test_check_summarises_a_valid_deck():
 
 def test_check_forecasts_a_mass_scaled_run_at_its_target_step():
     """The mass-scaled cantilever (Test 2) takes steps of its target 1.2e-5 to t = 0.12:
-    `check` says how much every mass grows and counts the steps of the target (10,000),
-    not of the unscaled critical step (four times as many)."""
+    `check` says how much every mass grows and counts the steps of the target, not of the
+    unscaled critical step (four times as many): 84 equal steps to each of its 120 output
+    times 0.001 apart (83.3 of the target apiece), 10,080."""
     result = runner.invoke(app, ["check", str(ROOT / "decks" / "verification"
                                               / "test02_cantilever_uniform_load_3_mass_scaled.toml")])
     said = " ".join(result.output.replace("│", " ").split())  # the table's cells, wrapped, as one text
     assert result.exit_code == 0, result.output
-    assert "for the mass scaling's step 1.2e-05: about 10,000 steps to the end" in said
+    assert "for the mass scaling's step 1.2e-05: about 10,080 steps to the end" in said
     assert "every mass x 1" in said
 
 

@@ -134,7 +134,7 @@ def check(deck: DeckPath, changes: DeckChanges = None) -> None:
     with err.status("building the model") as status, _compiles_shown(status):
         model = build_model(scene, mesh)
         status.update("timing a tangent and a residual" if newton_steps else "estimating the critical time step")
-        outlook = forecast(scene, model, lambda count: status.update(
+        outlook = forecast(scene, mesh, model, lambda count: status.update(
             f"estimating the critical time step: {count} stiffness products"))
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if not newton_steps:
@@ -159,6 +159,23 @@ def check(deck: DeckPath, changes: DeckChanges = None) -> None:
             "puts the time step above the critical step: the run will be unstable"
         )
     out.print(f"[green]ok[/] {deck}")
+
+
+def _step_fall(outlook: dict, at_rest: float, end_time: float) -> str:
+    """How the forecast followed the step as the loads act: the lowest critical step its
+    static rehearsal found, or why it held the step at rest."""
+    loaded = outlook["loaded"]
+    if loaded["rehearsed_to"] is None:
+        why = ("a scene this large is not rehearsed" if not loaded["tried"]
+               else "a static solve of its loads did not get past the start")
+        return (f"at the step at rest ({why}; the step falls as elements crumple or stiffen, and the steps and "
+                "cost grow with it; the run's progress shows the step as it goes)")
+    reach = (f"its loads followed statically to t = {loaded['rehearsed_to']:.4g}"
+             + (", the step held beyond" if loaded["rehearsed_to"] < end_time * (1 - 1e-9) else ""))
+    if loaded["critical"] < 0.95 * at_rest:
+        return (f"the critical step falling to {loaded['critical']:.4g} at t = {loaded['at']:.4g} as the loads act "
+                f"({reach}; the run's own motion and spreading contact can take it lower)")
+    return f"the critical step holding as the loads act ({reach})"
 
 
 def _warn_of_hanging_nodes(scene, mesh, model) -> None:
@@ -698,9 +715,8 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                    f"M2 {outlook['M2']:.4g})"
                                    + (f"; every mass x {outlook['mass_factor']:.4g} for the mass scaling's step "
                                       f"{outlook['dt']:.4g}" if outlook["mass_factor"] > 1.0 else "")
-                                   + f": about {outlook['steps']:,} steps to the end at that "
-                                   "step (it falls as elements crumple or stiffen, and the steps and cost grow "
-                                   "with it; the run's progress shows the step as it goes)")
+                                   + f": about {outlook['steps']:,} steps to the end, "
+                                   + _step_fall(outlook, outlook[sv.mass], sv.end_time))
         contact = (f"; contact {100 * outlook['contact_share']:.0f}% of each step at rest, more as it spreads"
                    if outlook["contact_share"] else "")
         row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "

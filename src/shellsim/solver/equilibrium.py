@@ -183,3 +183,13 @@ class Equilibrium:
         cols = np.broadcast_to(dofs[:, None, :], (len(nodes), 30, 30)).ravel()
         used = (rows >= 0) & (rows < u.n_free) & (cols >= 0)
         return sp.coo_matrix((blocks.ravel()[used], (rows[used], cols[used])), shape=(u.n_free, u.size))
+
+
+def warmed(model) -> Equilibrium:
+    """The static equilibrium of ``model`` at rest, its residual evaluated and a tangent
+    formed once: the kernels a Newton path calls compiled, or loaded from numba's cache,
+    before anything that follows is timed."""
+    equilibrium = Equilibrium(Simulation(model))
+    equilibrium.evaluate(0.0)
+    equilibrium.tangent()
+    return equilibrium

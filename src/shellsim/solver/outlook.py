@@ -15,6 +15,7 @@ import time
 from collections.abc import Callable
 from contextlib import suppress
 
+import numpy as np
 from numba import get_num_threads
 
 from ..bundles import Shape
@@ -23,11 +24,14 @@ from ..deck.schema import Solver
 from ..element.groups import group_count
 from ..errors import SceneTooLarge
 from ..memory import memory_bytes
+from ..mesh import Mesh
 from ..model import Model
 from ..loads import ToolForces, stable_step
-from .equilibrium import Equilibrium
+from .equilibrium import warmed
 from .simulation import Simulation
 from .sparse_lu import SymmetricPatternLU
+from .rehearsal import REHEARSAL_ELEMENTS, critical_steps_under_load
+from .timestep import MARGIN_SHARE, EstimateSchedule
 
 SECONDS_PER_GROUP_STEP = 130e-6
 #: A run longer than this is not one anybody will wait for: it is refused.
@@ -67,19 +71,25 @@ def time_step(solver: Solver, dt_critical: float) -> float:
 TIMING_SECONDS, TIMED_STEPS = 0.3, 20
 
 
-def measured_step_seconds(deck: Deck, model: Model, dt: float, mass_factor: float = 1.0) -> float:
-    """The wall time [s] of one explicit step of ``model`` at ``dt`` (every mass times
-    ``mass_factor``), timed on the scene itself on a copy at rest: the compiled loop for TIMED_STEPS steps or TIMING_SECONDS,
-    and a warm critical-step estimate spread over the ``solver.dt_update_every`` steps
-    between estimates. Small scenes are bound by the estimates and the loop's own
-    overheads, not by their elements: on 3 to 19 elements the shipped decks took 160 to
-    980 us a step where a rate per element said 130."""
-    sim = Simulation(model)
+def loop_costs(run, dt: float, mass_factor: float = 1.0) -> dict:
+    """The wall times [s] of the time loop's parts, timed on the prepared ``run``
+    (:func:`shellsim.solver.run.prepare`) at rest, every mass times ``mass_factor``:
+    ``step``, one step of the compiled loop at ``dt`` (TIMED_STEPS steps a call for
+    TIMING_SECONDS); ``call``, what each return to Python adds (a single-step call's
+    time less a step); ``sample``, a history sample and the stability check after it;
+    ``estimate``, a warm critical-step estimate with the masses and the element quality
+    it updates. Small scenes are bound by these and not by their elements: on 2 to 19
+    elements the shipped decks took 160 to 980 us a step where a rate per element said
+    130."""
+    from .run import Listener, _check_stability, _update_time_step, take_sample
+
+    sim, quiet = run.sim, Listener()
     sim.mass_factor = mass_factor
-    sim.update_masses()
-    sim.critical_time_step()
-    estimate = _quickest(sim.critical_time_step, 1)  # warm, as the run's later estimates are
-    end = deck.solver.end_time  # a finite stop: toward an infinite one each step took 50 times as long
+    _update_time_step(run, quiet)
+    estimate = _quickest(lambda: _update_time_step(run, quiet), 1)
+    run.dt = dt
+    sample = _quickest(lambda: (take_sample(run, quiet), _check_stability(run)), 3)
+    end = run.deck.solver.end_time  # a finite stop: toward an infinite one each step took 50 times as long
     sim.advance(end, dt, 2)  # the first call may load the kernels
     steps, start = 0, time.perf_counter()
     while steps < TIMED_STEPS or time.perf_counter() - start < TIMING_SECONDS and steps < 100 * TIMED_STEPS:
@@ -87,19 +97,88 @@ def measured_step_seconds(deck: Deck, model: Model, dt: float, mass_factor: floa
         if not taken:  # at the end already (a scene of a few steps)
             break
         steps += taken
-    loop = (time.perf_counter() - start) / steps if steps else 0.0
-    return loop + estimate / deck.solver.dt_update_every
+    step = (time.perf_counter() - start) / steps if steps else 0.0
+    single = _quickest(lambda: sim.advance(end, dt, 1), 5)
+    return {"step": step, "call": max(single - step, 0.0), "sample": sample, "estimate": estimate}
 
 
-def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+def explicit_schedule(deck: Deck, times: np.ndarray, dts: np.ndarray) -> dict:
+    """How the time loop will take the deck with the step ``dts`` (k,) at ``times`` (k,)
+    (linear between, held beyond): ``steps``, equal steps landing on every output time (a
+    landing 1.4 steps on takes 2); ``samples``, the history samples on whole steps between
+    landings; ``estimates``, the critical-step estimates after the first, as
+    :class:`~.timestep.EstimateSchedule` spaces them: from FIRST steps, doubling to
+    ``solver.dt_update_every`` while the step holds, closer where it changes."""
+    from .run import HISTORY_SAMPLES, output_times
+
+    solver = deck.solver
+    landings = output_times(deck)
+    grid = np.unique(np.concatenate([np.linspace(0.0, solver.end_time, 4001), landings, times]))
+    grid = grid[grid <= solver.end_time]
+    step = np.interp(grid, times, dts)
+    taken = np.concatenate([[0.0], np.cumsum(np.diff(grid) * 0.5 * (1.0 / step[1:] + 1.0 / step[:-1]))])
+    per_segment = np.maximum(1.0, np.ceil(np.diff(np.interp(landings, grid, taken), prepend=0.0) - 1e-9))
+    segments = np.diff(landings, prepend=0.0)
+    per_sample = np.maximum(1.0, np.round(solver.end_time / HISTORY_SAMPLES / (segments / per_segment)))
+    change = np.abs(np.gradient(np.log(step), grid)) * step if len(grid) > 1 else np.zeros(1)  # of ln(step), per step
+    margin = MARGIN_SHARE * math.log(solver.dt_safety_factor) if solver.dt_safety_factor > 1.0 else 0.0
+    estimates = _estimate_count(taken, change, margin, solver.dt_update_every)
+    return {"steps": int(per_segment.sum()), "samples": int(np.ceil(per_segment / per_sample).sum()),
+            "estimates": estimates}
+
+
+#: Estimates the walk of :func:`_estimate_count` counts one by one before it extrapolates.
+WALK_LIMIT = 100_000
+
+
+def _estimate_count(taken: np.ndarray, change: np.ndarray, margin: float, most: int) -> int:
+    """The estimates after the first that :class:`~.timestep.EstimateSchedule` makes over
+    ``taken[-1]`` steps, ``taken`` (g,) the steps taken by each point of a time grid and
+    ``change`` (g,) the change of ln(step) per step there: each interval at most
+    ``margin`` over the fastest change of the last ``most`` steps, twice the one before and
+    ``most``. Where no later change can shorten an interval of ``most``, the rest is
+    counted at once (a hopeless scene's 10^20 steps)."""
+    total = taken[-1]
+    calm = margin / most if margin else math.inf  # a change this slow leaves the interval at most
+    later = np.maximum.accumulate(change[::-1])[::-1]  # the fastest change from each point on
+    estimates, interval, at = 0, min(EstimateSchedule.FIRST, most), 0.0
+    while at + interval < total:
+        at += interval
+        estimates += 1
+        first, last = np.searchsorted(taken, at - most), np.searchsorted(taken, at, side="right")
+        if interval == most and later[min(first, len(later) - 1)] <= calm:
+            return estimates + max(0, math.ceil((total - at) / most) - 1)
+        if estimates >= WALK_LIMIT:
+            return estimates + int((total - at) / (at / estimates))
+        rate = float(change[first:last].max()) if last > first else float(np.interp(at, taken, change))
+        proposed = margin / rate if margin and rate > 0.0 else math.inf
+        interval = most if not margin else int(max(1, min(most, 2 * interval, proposed)))
+    return estimates
+
+
+def _scaled_step(solver: Solver, critical: float, mass_factor: float) -> float:
+    """The step a run takes at the critical step ``critical`` of the unscaled masses, every
+    mass times ``mass_factor``: scaled throughout, never below the scaling's target."""
+    dt = time_step(solver, critical * math.sqrt(mass_factor))
+    scaling = solver.mass_scaling
+    return max(dt, scaling.step) if scaling is not None and scaling.throughout else dt
+
+
+def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What the run's time step will be, before it starts: the critical step at t = 0
     [time] with each lumping, ``{"M1": .., "M2": ..}``; ``dt``, the step the run takes
     first, with the deck's lumping and safety factor, or the mass scaling's target and
     ``mass_factor`` the masses' factor that reaches it (1 without); ``steps``, the number
-    of steps of ``dt`` to the end time (a stiffening scene takes more); ``seconds``, about
-    how long the first estimate and the steps take, ``contact_share`` the contacts' share of that (timed at rest), and
-    ``bytes``, the memory the run holds. ``on_product(count)`` is told each stiffness
-    product of the estimates."""
+    of steps that land on every output time to the end, the step following the critical
+    step as the loads act (:func:`.rehearsal.critical_steps_under_load`, on scenes of up
+    to REHEARSAL_ELEMENTS elements); ``loaded``, the lowest critical step found
+    (``critical``), when (``at``), whether a rehearsal was ``tried`` and how far it went
+    (``rehearsed_to``; None: not past the start); ``seconds``, about how long the first estimate and the time loop take
+    (:func:`loop_costs` for :func:`explicit_schedule`), ``contact_share`` the contacts'
+    share of a step (timed at rest), and ``bytes``, the memory the run holds.
+    ``on_product(count)`` is told each stiffness product of the estimates."""
+    from .run import prepare
+
     initial = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
     critical, cold = {}, 0.0
     for mass in ("M1", "M2"):
@@ -112,10 +191,22 @@ def step_outlook(deck: Deck, model: Model, on_product: Callable[[int], None] | N
     if scaling is not None and dt < scaling.step:  # every mass scaled, the step the target
         mass_factor, dt = (scaling.step / dt) ** 2, scaling.step
     contact = contact_seconds(model, 0.0, initial)
-    per_step = measured_step_seconds(deck, model._replace(mass=deck.solver.mass), dt, mass_factor)
-    steps = math.ceil(deck.solver.end_time / dt)
-    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": steps, "seconds": cold + steps * per_step,
-                       "contact_share": contact / per_step, "bytes": memory_bytes(model.n_elements)}
+    costs = loop_costs(prepare(deck, mesh, model._replace(mass=deck.solver.mass)), dt, mass_factor)
+    times, under_load = np.zeros(1), np.full(1, critical[deck.solver.mass])
+    tried = model.n_elements <= REHEARSAL_ELEMENTS
+    if tried:
+        rehearsed = critical_steps_under_load(deck, mesh, model._replace(mass=deck.solver.mass))
+        if len(rehearsed[0]):  # else the static solve could not even start
+            times, under_load = rehearsed
+    dts = np.array([_scaled_step(deck.solver, c, mass_factor) for c in under_load])
+    schedule = explicit_schedule(deck, times, dts)
+    seconds = (cold + schedule["steps"] * costs["step"] + schedule["estimates"] * (costs["estimate"] + costs["call"])
+               + schedule["samples"] * (costs["sample"] + costs["call"]))
+    lowest = int(np.argmin(under_load))
+    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": schedule["steps"], "seconds": seconds,
+                       "loaded": {"critical": float(under_load[lowest]), "at": float(times[lowest]),
+                                  "rehearsed_to": float(times[-1]) if len(times) > 1 else None, "tried": tried},
+                       "contact_share": contact / costs["step"], "bytes": memory_bytes(model.n_elements)}
 
 
 def static_outlook(model: Model) -> dict:
@@ -125,9 +216,7 @@ def static_outlook(model: Model) -> dict:
     on this machine's threads (timed: the rate per element said 0.056 s where the aortic
     valve's tangent and factors took 0.22 s, the follower pressure's and the contact's
     tangents and the factors left out), ``bytes``."""
-    equilibrium = Equilibrium(Simulation(model))
-    equilibrium.evaluate(0.0)
-    equilibrium.tangent()  # the first call may compile the kernels
+    equilibrium = warmed(model)
 
     def factorised() -> None:
         tangent = equilibrium.tangent()
@@ -177,13 +266,13 @@ def newton_steps(deck: Deck) -> int:
     return math.ceil(steps * (ARC_STEPS if newton_path(deck) == "arc_length" else 1.0))
 
 
-def forecast(deck: Deck, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
     """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
     outlook they come from: :func:`step_outlook`'s for the explicit path; for a Newton
     path :func:`static_outlook`'s, its time per tangent as ``tangent_seconds``, and the
     iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``)."""
     if deck.solver.method == "explicit":
-        return step_outlook(deck, model, on_product)
+        return step_outlook(deck, mesh, model, on_product)
     outlook = static_outlook(model)
     steps = newton_steps(deck)
     iterations, tangents = pace = NEWTON_PACE[newton_path(deck)]

@@ -715,8 +715,11 @@ def _summary(scene: Any, built: Any, needs: Any, outlook: dict) -> Table:
                                    f"M2 {outlook['M2']:.4g})"
                                    + (f"; every mass x {outlook['mass_factor']:.4g} for the mass scaling's step "
                                       f"{outlook['dt']:.4g}" if outlook["mass_factor"] > 1.0 else "")
-                                   + f": about {outlook['steps']:,} steps to the end, "
-                                   + _step_fall(outlook, outlook[sv.mass], sv.end_time))
+                                   + f": about {outlook['steps']:,} steps "
+                                   + ("to the end" if outlook["until"] >= sv.end_time else
+                                      f"to t = {outlook['until']:.4g}, where its curves hold and it may first come "
+                                      "to rest")
+                                   + ", " + _step_fall(outlook, outlook[sv.mass], sv.end_time))
         contact = (f"; contact {100 * outlook['contact_share']:.0f}% of each step at rest, more as it spreads"
                    if outlook["contact_share"] else "")
         row("cost", f"about {duration(outlook['seconds'])} of stepping on this machine "

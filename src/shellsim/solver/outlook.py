@@ -19,6 +19,7 @@ import numpy as np
 from numba import get_num_threads
 
 from ..bundles import Shape
+from ..curve_tables import held_from
 from ..deck import Deck
 from ..deck.schema import Solver
 from ..element.groups import group_count
@@ -102,25 +103,29 @@ def loop_costs(run, dt: float, mass_factor: float = 1.0) -> dict:
     return {"step": step, "call": max(single - step, 0.0), "sample": sample, "estimate": estimate}
 
 
-def explicit_schedule(deck: Deck, times: np.ndarray, dts: np.ndarray) -> dict:
-    """How the time loop will take the deck with the step ``dts`` (k,) at ``times`` (k,)
-    (linear between, held beyond): ``steps``, equal steps landing on every output time (a
-    landing 1.4 steps on takes 2); ``samples``, the history samples on whole steps between
-    landings; ``estimates``, the critical-step estimates after the first, as
-    :class:`~.timestep.EstimateSchedule` spaces them: from FIRST steps, doubling to
-    ``solver.dt_update_every`` while the step holds, closer where it changes."""
+def explicit_schedule(deck: Deck, times: np.ndarray, dts: np.ndarray, until: float | None = None) -> dict:
+    """How the time loop will take the deck to ``until`` (its end time by default) with
+    the step ``dts`` (k,) at ``times`` (k,) (linear between, held beyond): ``steps``, equal
+    steps landing on every output time (a landing 1.4 steps on takes 2); ``samples``, the
+    history samples on whole steps between landings; ``estimates``, the critical-step
+    estimates after the first, as :class:`~.timestep.EstimateSchedule` spaces them: from
+    FIRST steps, doubling to ``solver.dt_update_every`` while the step holds, closer where
+    it changes."""
     from .run import HISTORY_SAMPLES, output_times
 
     solver = deck.solver
+    end = solver.end_time if until is None else min(until, solver.end_time)
     landings = output_times(deck)
-    grid = np.unique(np.concatenate([np.linspace(0.0, solver.end_time, 4001), landings, times]))
-    grid = grid[grid <= solver.end_time]
+    landings = np.append(landings[landings < end], end)
+    grid = np.unique(np.concatenate([np.linspace(0.0, end, 4001), landings, times]))
+    grid = grid[(grid <= end) & (np.diff(grid, prepend=-np.inf) > 1e-9 * end)]
     step = np.interp(grid, times, dts)
     taken = np.concatenate([[0.0], np.cumsum(np.diff(grid) * 0.5 * (1.0 / step[1:] + 1.0 / step[:-1]))])
     per_segment = np.maximum(1.0, np.ceil(np.diff(np.interp(landings, grid, taken), prepend=0.0) - 1e-9))
     segments = np.diff(landings, prepend=0.0)
     per_sample = np.maximum(1.0, np.round(solver.end_time / HISTORY_SAMPLES / (segments / per_segment)))
-    change = np.abs(np.gradient(np.log(step), grid)) * step if len(grid) > 1 else np.zeros(1)  # of ln(step), per step
+    between = np.abs(np.diff(np.log(step))) / np.diff(taken)  # the change of ln(step) per step
+    change = np.maximum(np.append(between, 0.0), np.insert(between, 0, 0.0))  # at each point, either side's
     margin = MARGIN_SHARE * math.log(solver.dt_safety_factor) if solver.dt_safety_factor > 1.0 else 0.0
     estimates = _estimate_count(taken, change, margin, solver.dt_update_every)
     return {"steps": int(per_segment.sum()), "samples": int(np.ceil(per_segment / per_sample).sum()),
@@ -169,12 +174,14 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
     [time] with each lumping, ``{"M1": .., "M2": ..}``; ``dt``, the step the run takes
     first, with the deck's lumping and safety factor, or the mass scaling's target and
     ``mass_factor`` the masses' factor that reaches it (1 without); ``steps``, the number
-    of steps that land on every output time to the end, the step following the critical
+    of steps that land on every output time ``until`` the end (a relaxation's until its
+    curves hold, where it may first come to rest), the step following the critical
     step as the loads act (:func:`.rehearsal.critical_steps_under_load`, on scenes of up
     to REHEARSAL_ELEMENTS elements); ``loaded``, the lowest critical step found
     (``critical``), when (``at``), whether a rehearsal was ``tried`` and how far it went
-    (``rehearsed_to``; None: not past the start); ``seconds``, about how long the first estimate and the time loop take
-    (:func:`loop_costs` for :func:`explicit_schedule`), ``contact_share`` the contacts'
+    (``rehearsed_to``; None: not past the start); ``seconds``, about how long the first
+    estimate and the time loop take (:func:`loop_costs` for :func:`explicit_schedule`),
+    ``contact_share`` the contacts'
     share of a step (timed at rest), and ``bytes``, the memory the run holds.
     ``on_product(count)`` is told each stiffness product of the estimates."""
     from .run import prepare
@@ -199,11 +206,14 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
         if len(rehearsed[0]):  # else the static solve could not even start
             times, under_load = rehearsed
     dts = np.array([_scaled_step(deck.solver, c, mass_factor) for c in under_load])
-    schedule = explicit_schedule(deck, times, dts)
+    # a relaxation ends at rest, once its curves hold: no sooner than that
+    until = min(held_from(model.curves), deck.solver.end_time) if deck.solver.relaxation else deck.solver.end_time
+    schedule = explicit_schedule(deck, times, dts, until)
     seconds = (cold + schedule["steps"] * costs["step"] + schedule["estimates"] * (costs["estimate"] + costs["call"])
                + schedule["samples"] * (costs["sample"] + costs["call"]))
     lowest = int(np.argmin(under_load))
-    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": schedule["steps"], "seconds": seconds,
+    return critical | {"dt": dt, "mass_factor": mass_factor, "steps": schedule["steps"], "until": until,
+                       "seconds": seconds,
                        "loaded": {"critical": float(under_load[lowest]), "at": float(times[lowest]),
                                   "rehearsed_to": float(times[-1]) if len(times) > 1 else None, "tried": tried},
                        "contact_share": contact / costs["step"], "bytes": memory_bytes(model.n_elements)}

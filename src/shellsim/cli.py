@@ -135,7 +135,7 @@ def check(deck: DeckPath, changes: DeckChanges = None) -> None:
         model = build_model(scene, mesh)
         status.update("timing a tangent and a residual" if newton_steps else "estimating the critical time step")
         outlook = forecast(scene, mesh, model, lambda count: status.update(
-            f"estimating the critical time step: {count} stiffness products"))
+            f"estimating the critical time step: {count} stiffness products"), status.update)
     out.print(_summary(scene, mesh, plan(scene), outlook))
     if not newton_steps:
         refuse_if_hopeless(scene, mesh.n_elements, outlook["dt"])

@@ -14,6 +14,7 @@ import math
 import time
 from collections.abc import Callable
 from contextlib import suppress
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import get_num_threads
@@ -31,8 +32,11 @@ from ..loads import ToolForces, stable_step
 from .equilibrium import warmed
 from .simulation import Simulation
 from .sparse_lu import SymmetricPatternLU
-from .rehearsal import REHEARSAL_ELEMENTS, critical_steps_under_load
+from .rehearsal import REHEARSAL_ELEMENTS, REHEARSAL_SECONDS, critical_steps_under_load
 from .timestep import MARGIN_SHARE, EstimateSchedule
+
+if TYPE_CHECKING:
+    from .run import Run
 
 SECONDS_PER_GROUP_STEP = 130e-6
 #: A run longer than this is not one anybody will wait for: it is refused.
@@ -72,7 +76,7 @@ def time_step(solver: Solver, dt_critical: float) -> float:
 TIMING_SECONDS, TIMED_STEPS = 0.3, 20
 
 
-def loop_costs(run, dt: float, mass_factor: float = 1.0) -> dict:
+def loop_costs(run: Run, dt: float, mass_factor: float = 1.0) -> dict:
     """The wall times [s] of the time loop's parts, timed on the prepared ``run``
     (:func:`shellsim.solver.run.prepare`) at rest, every mass times ``mass_factor``:
     ``step``, one step of the compiled loop at ``dt`` (TIMED_STEPS steps a call for
@@ -82,14 +86,14 @@ def loop_costs(run, dt: float, mass_factor: float = 1.0) -> dict:
     it updates. Small scenes are bound by these and not by their elements: on 2 to 19
     elements the shipped decks took 160 to 980 us a step where a rate per element said
     130."""
-    from .run import Listener, _check_stability, _update_time_step, take_sample
+    from .run import Listener, check_unstable, update_time_step, take_sample
 
     sim, quiet = run.sim, Listener()
     sim.mass_factor = mass_factor
-    _update_time_step(run, quiet)
-    estimate = _quickest(lambda: _update_time_step(run, quiet), 1)
+    update_time_step(run, quiet)
+    estimate = _quickest(lambda: update_time_step(run, quiet), 1)
     run.dt = dt
-    sample = _quickest(lambda: (take_sample(run, quiet), _check_stability(run)), 3)
+    sample = _quickest(lambda: (take_sample(run, quiet), check_unstable(run)), 3)
     end = run.deck.solver.end_time  # a finite stop: toward an infinite one each step took 50 times as long
     sim.advance(end, dt, 2)  # the first call may load the kernels
     steps, start = 0, time.perf_counter()
@@ -169,7 +173,8 @@ def _scaled_step(solver: Solver, critical: float, mass_factor: float) -> float:
     return max(dt, scaling.step) if scaling is not None and scaling.throughout else dt
 
 
-def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None,
+                 announce: Callable[[str], None] = lambda text: None) -> dict:
     """What the run's time step will be, before it starts: the critical step at t = 0
     [time] with each lumping, ``{"M1": .., "M2": ..}``; ``dt``, the step the run takes
     first, with the deck's lumping and safety factor, or the mass scaling's target and
@@ -181,9 +186,10 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
     (``critical``), when (``at``), whether a rehearsal was ``tried`` and how far it went
     (``rehearsed_to``; None: not past the start); ``seconds``, about how long the first
     estimate and the time loop take (:func:`loop_costs` for :func:`explicit_schedule`),
-    ``contact_share`` the contacts'
-    share of a step (timed at rest), and ``bytes``, the memory the run holds.
-    ``on_product(count)`` is told each stiffness product of the estimates."""
+    ``contact_share`` the contacts' share of a step (timed at rest), and ``bytes``, the
+    memory the run holds.
+    ``on_product(count)`` is told each stiffness product of the estimates, ``announce``
+    each stage that follows them."""
     from .run import prepare
 
     initial = Shape(x=model.x0, d=model.d0, e1=model.e1f0, h=model.h0)
@@ -199,24 +205,33 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
         mass_factor, dt = (scaling.step / dt) ** 2, scaling.step
     contact = contact_seconds(model, 0.0, initial)
     costs = loop_costs(prepare(deck, mesh, model._replace(mass=deck.solver.mass)), dt, mass_factor)
-    times, under_load = np.zeros(1), np.full(1, critical[deck.solver.mass])
-    tried = model.n_elements <= REHEARSAL_ELEMENTS
-    if tried:
-        rehearsed = critical_steps_under_load(deck, mesh, model._replace(mass=deck.solver.mass))
-        if len(rehearsed[0]):  # else the static solve could not even start
-            times, under_load = rehearsed
-    dts = np.array([_scaled_step(deck.solver, c, mass_factor) for c in under_load])
+    times, under_load, loaded = _critical_under_load(deck, mesh, model, critical[deck.solver.mass], announce)
     # a relaxation ends at rest, once its curves hold: no sooner than that
     until = min(held_from(model.curves), deck.solver.end_time) if deck.solver.relaxation else deck.solver.end_time
-    schedule = explicit_schedule(deck, times, dts, until)
+    schedule = explicit_schedule(deck, times, np.array([_scaled_step(deck.solver, c, mass_factor) for c in under_load]),
+                                 until)
     seconds = (cold + schedule["steps"] * costs["step"] + schedule["estimates"] * (costs["estimate"] + costs["call"])
                + schedule["samples"] * (costs["sample"] + costs["call"]))
-    lowest = int(np.argmin(under_load))
     return critical | {"dt": dt, "mass_factor": mass_factor, "steps": schedule["steps"], "until": until,
-                       "seconds": seconds,
-                       "loaded": {"critical": float(under_load[lowest]), "at": float(times[lowest]),
-                                  "rehearsed_to": float(times[-1]) if len(times) > 1 else None, "tried": tried},
-                       "contact_share": contact / costs["step"], "bytes": memory_bytes(model.n_elements)}
+                       "seconds": seconds, "loaded": loaded, "contact_share": contact / costs["step"],
+                       "bytes": memory_bytes(model.n_elements)}
+
+
+def _critical_under_load(deck: Deck, mesh: Mesh, model: Model, at_rest: float,
+                         announce: Callable[[str], None]) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(times (k,), critical (k,), loaded): the critical step as the loads act, from the
+    static rehearsal on scenes of up to REHEARSAL_ELEMENTS elements, else ``at_rest`` at
+    t = 0 alone; ``loaded`` as :func:`step_outlook` describes it."""
+    times, critical = np.zeros(1), np.full(1, at_rest)
+    tried = model.n_elements <= REHEARSAL_ELEMENTS
+    if tried:
+        announce(f"following the loads statically to foresee the step's fall (at most {REHEARSAL_SECONDS:g} s)")
+        rehearsed = critical_steps_under_load(deck, mesh, model._replace(mass=deck.solver.mass))
+        if len(rehearsed[0]):  # else the static solve could not even start
+            times, critical = rehearsed
+    lowest = int(np.argmin(critical))
+    return times, critical, {"critical": float(critical[lowest]), "at": float(times[lowest]), "tried": tried,
+                             "rehearsed_to": float(times[-1]) if len(times) > 1 else None}
 
 
 def static_outlook(model: Model) -> dict:
@@ -276,13 +291,14 @@ def newton_steps(deck: Deck) -> int:
     return math.ceil(steps * (ARC_STEPS if newton_path(deck) == "arc_length" else 1.0))
 
 
-def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None) -> dict:
+def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None,
+             announce: Callable[[str], None] = lambda text: None) -> dict:
     """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
     outlook they come from: :func:`step_outlook`'s for the explicit path; for a Newton
     path :func:`static_outlook`'s, its time per tangent as ``tangent_seconds``, and the
     iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``)."""
     if deck.solver.method == "explicit":
-        return step_outlook(deck, mesh, model, on_product)
+        return step_outlook(deck, mesh, model, on_product, announce)
     outlook = static_outlook(model)
     steps = newton_steps(deck)
     iterations, tangents = pace = NEWTON_PACE[newton_path(deck)]

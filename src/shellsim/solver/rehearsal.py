@@ -39,12 +39,12 @@ class _Spent(Exception):
 
 
 def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
-                              seconds: float = REHEARSAL_SECONDS) -> tuple[np.ndarray, np.ndarray]:
+                              seconds: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(times (k,), critical (k,)): the structure's critical step [time] (the contacts'
     and the cables' share included, :func:`shellsim.loads.stable_step`) at the start and
-    at each state a static solve of the deck's loads converged on within ``seconds``,
-    in time order. Nothing the static solve meets stops the forecast: it ends the
-    rehearsal."""
+    at each state a static solve of the deck's loads converged on within ``seconds``
+    (REHEARSAL_SECONDS by default), in time order. Nothing the static solve meets stops
+    the forecast: it ends the rehearsal."""
     from .run import Listener, prepare
     from .static_solve import solve_static
 
@@ -68,7 +68,7 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
 
     try:
         warmed(model)  # the budget is the solve's, not the kernels' loading
-        stop = time.perf_counter() + seconds
+        stop = time.perf_counter() + (REHEARSAL_SECONDS if seconds is None else seconds)
         solve_static(prepare(rehearsal, mesh, model), Estimates())
     except (_Spent, ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError):
         pass  # the states found until then

@@ -256,7 +256,7 @@ def _watch_quality(run: Run) -> None:
         run.lowest = run.worst
 
 
-def _update_time_step(run: Run, listener: Listener) -> float:
+def update_time_step(run: Run, listener: Listener) -> float:
     """The masses and the critical step (``run.dt_critical``) and step (``run.dt``) on the
     current shape; returns the shell structure's own critical step."""
     _watch_quality(run)
@@ -331,7 +331,7 @@ def _scale_masses(run: Run, listener: Listener) -> None:
                             f"{MOST_MASS_FACTOR:g}, and the run would follow another, far heavier structure; ask "
                             f"for a step of at most {run.dt * MOST_MASS_FACTOR ** 0.5:.3g}")
     run.sim.mass_factor = factor
-    structure = _update_time_step(run, listener)
+    structure = update_time_step(run, listener)
     if needs_calibration(run.model):  # the penalties' step and the contact nodes' masses are the scaled ones
         s = run.sim.state
         calibrate(run.model, s.mt, s.mr, springs_step(run.deck, run.model, structure))
@@ -350,7 +350,9 @@ def springs_step(deck: Deck, model: Model, structure: float) -> float:
     return min(structure, solver.dt_max * solver.dt_safety_factor / step_share(model))
 
 
-def _check_stability(run: Run) -> None:
+def check_unstable(run: Run) -> None:
+    """Raise NumericalError when the state is no number or the energy balance is off by
+    more than UNSTABLE_BALANCE of the energies' scale."""
     s = run.sim.state
     e = s.energy
     broken = not (np.isfinite(s.x).all() and np.isfinite(e).all())
@@ -432,7 +434,7 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
     sim = run.sim
     with ending(run, listener, "unstable", _breakdown_cause) as start:
         if run.stepping is None:  # else it goes on from a checkpoint
-            _update_time_step(run, listener)
+            update_time_step(run, listener)
             _scale_masses(run, listener)
             refuse_if_hopeless(run.deck, run.model.n_elements, run.dt)
             run.startup["first_dt_s"] = time.perf_counter() - start
@@ -454,13 +456,13 @@ def integrate(run: Run, listener: Listener | None = None) -> Run:
                     steps = sim.advance(target, step, stepping.interval - stepping.since_update)
                     stepping.since_update += steps
                     if stepping.since_update >= stepping.interval:
-                        _update_time_step(run, listener)
+                        update_time_step(run, listener)
                         _hold_scaled_step(run)
                         stepping.interval = stepping.schedule.after_estimate(sim.state.steps, _unscaled_critical(run))
                         stepping.since_update = 0
                         break  # re-plan the steps with the new dt
                 take_sample(run, listener)
-                _check_stability(run)
+                check_unstable(run)
                 at_rest = run.relaxing is not None and run.relaxing.at_rest(sim)
             take_frame(run, listener)
             if at_rest:

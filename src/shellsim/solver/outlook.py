@@ -2,10 +2,12 @@
 and the wall time they take; a scene that cannot fit in memory or finish in a year is
 refused with the numbers that say why.
 
-The explicit step's rate is measured on this project's reference machine
-(docs/verification.md, "Cost of a scene"): one step of a group of 16 elements takes
-about 130 us on one thread; the contacts' forces and a Newton path's tangent are timed on
-the scene itself; the memory a run holds is :mod:`shellsim.memory`'s.
+A forecast times the scene itself (docs/verification.md, "Cost of a scene"): the explicit
+loop's parts on the prepared scene at rest, counted as the loop will take them with the
+step following the loads (:mod:`.rehearsal`); a Newton path's tangent and residual. Only
+refusing a hopeless scene, before anything is built, goes by a rate: one step of a group
+of 16 elements takes about 130 us on one thread on this project's reference machine. The
+memory a run holds is :mod:`shellsim.memory`'s.
 """
 
 from __future__ import annotations

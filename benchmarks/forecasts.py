@@ -34,12 +34,14 @@ def measured(deck: Path, earlier: dict | None = None) -> dict:
     renders, or taken from ``earlier`` (a row of an earlier run of this script)."""
     from shellsim.study.jobs import variant_deck
 
-    run = built_run(variant_deck(deck, {"output.render": []}), deck.parent)
-    ahead = forecast(run.deck, run.mesh, run.model)
-    row = {"deck": str(deck.relative_to(ROOT)), "method": run.deck.solver.method, "elements": run.model.n_elements,
+    scene = variant_deck(deck, {"output.render": []})
+    checked = built_run(scene, deck.parent)  # as check builds it
+    ahead = forecast(checked.deck, checked.mesh, checked.model)
+    row = {"deck": str(deck.relative_to(ROOT)), "method": scene.solver.method, "elements": checked.model.n_elements,
            "forecast_steps": ahead["steps"], "forecast_s": ahead["seconds"], "tangent_s": ahead.get("tangent_seconds")}
     if earlier is not None:
         return earlier | row
+    run = built_run(scene, deck.parent)  # a run of its own, untouched by the forecast's timings
     start = time.perf_counter()
     solve(run)
     wall = time.perf_counter() - start

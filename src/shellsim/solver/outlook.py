@@ -298,7 +298,8 @@ def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], N
     """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
     outlook they come from: :func:`step_outlook`'s for the explicit path; for a Newton
     path :func:`static_outlook`'s, its time per tangent as ``tangent_seconds``, and the
-    iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``)."""
+    iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``). The
+    model's penalty springs are left set as a run's :func:`~.run.prepare` sets them."""
     if deck.solver.method == "explicit":
         return step_outlook(deck, mesh, model, on_product, announce)
     outlook = static_outlook(model)

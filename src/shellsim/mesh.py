@@ -7,7 +7,6 @@ Node order inside an element is the thesis' (:mod:`shellsim.element.shape`).
 from __future__ import annotations
 
 import functools
-
 from collections import deque
 from dataclasses import dataclass, field
 

@@ -20,6 +20,7 @@ from ..element.static_loop import ElementLoop
 from ..element.tangent import ELEMENT_DOFS
 from ..curve_tables import factor
 from ..loads import LoadTangents
+from ..model import Model
 from .simulation import Simulation
 from .tangent_pattern import tangent_pattern
 from .unknowns import SLOTS, unknowns
@@ -185,7 +186,7 @@ class Equilibrium:
         return sp.coo_matrix((blocks.ravel()[used], (rows[used], cols[used])), shape=(u.n_free, u.size))
 
 
-def warmed(model) -> Equilibrium:
+def warmed(model: Model) -> Equilibrium:
     """The static equilibrium of ``model`` at rest, its residual evaluated and a tangent
     formed once: the kernels a Newton path calls compiled, or loaded from numba's cache,
     before anything that follows is timed."""

@@ -127,6 +127,7 @@ def explicit_schedule(deck: Deck, times: np.ndarray, dts: np.ndarray, until: flo
     grid = grid[(grid <= end) & (np.diff(grid, prepend=-np.inf) > 1e-9 * end)]
     step = np.interp(grid, times, dts)
     taken = np.concatenate([[0.0], np.cumsum(np.diff(grid) * 0.5 * (1.0 / step[1:] + 1.0 / step[:-1]))])
+    # equal steps to each landing, rounded up as :func:`.explicit.equal_step` rounds them
     per_segment = np.maximum(1.0, np.ceil(np.diff(np.interp(landings, grid, taken), prepend=0.0) - 1e-9))
     segments = np.diff(landings, prepend=0.0)
     per_sample = np.maximum(1.0, np.round(solver.end_time / HISTORY_SAMPLES / (segments / per_segment)))
@@ -206,8 +207,9 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
     if scaling is not None and dt < scaling.step:  # every mass scaled, the step the target
         mass_factor, dt = (scaling.step / dt) ** 2, scaling.step
     contact = contact_seconds(model, 0.0, initial)
-    costs = loop_costs(prepare(deck, mesh, model._replace(mass=deck.solver.mass)), dt, mass_factor)
-    times, under_load, loaded = _critical_under_load(deck, mesh, model, critical[deck.solver.mass], announce)
+    lumped = model._replace(mass=deck.solver.mass)  # the deck's lumping, as the run's
+    costs = loop_costs(prepare(deck, mesh, lumped), dt, mass_factor)
+    times, under_load, loaded = _critical_under_load(deck, mesh, lumped, critical[deck.solver.mass], announce)
     # a relaxation ends at rest, once its curves hold: no sooner than that
     until = min(held_from(model.curves), deck.solver.end_time) if deck.solver.relaxation else deck.solver.end_time
     schedule = explicit_schedule(deck, times, np.array([_scaled_step(deck.solver, c, mass_factor) for c in under_load]),
@@ -228,7 +230,7 @@ def _critical_under_load(deck: Deck, mesh: Mesh, model: Model, at_rest: float,
     tried = model.n_elements <= REHEARSAL_ELEMENTS
     if tried:
         announce(f"following the loads statically to foresee the step's fall (at most {REHEARSAL_SECONDS:g} s)")
-        rehearsed = critical_steps_under_load(deck, mesh, model._replace(mass=deck.solver.mass))
+        rehearsed = critical_steps_under_load(deck, mesh, model)
         if len(rehearsed[0]):  # else the static solve could not even start
             times, critical = rehearsed
     lowest = int(np.argmin(critical))

@@ -48,7 +48,8 @@ def measured(deck: Path, earlier: dict | None = None) -> dict:
     newton = run.newton
     return row | {"status": run.status, "steps": int(run.sim.state.steps), "wall_s": wall,
                   "iterations": sum(step.iterations for step in newton),
-                  "tangents": sum(step.tangents for step in newton)}
+                  "tangents": sum(step.tangents for step in newton),  # those its converged steps used
+                  "tangents_formed": len(run.tangent_seconds)}  # every one, stability checks and cut tries too
 
 
 def table(rows: list[dict]) -> str:

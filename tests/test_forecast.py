@@ -1,6 +1,7 @@
-"""The explicit forecast: the steps a run takes to land on its output times, the
+"""The forecast: the explicit steps a run takes to land on its output times, the
 estimates its schedule makes, and the critical step followed under the loads by a static
-rehearsal; checked against closed forms and against the run itself."""
+rehearsal; a Newton path's steps rehearsed; checked against closed forms and against the
+run itself."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 from shellsim.deck import parse_deck
-from shellsim.solver.outlook import explicit_schedule, forecast
+from shellsim.solver.outlook import NEWTON_PACE, explicit_schedule, forecast, newton_steps
 from shellsim.solver import rehearsal
 from shellsim.solver.rehearsal import critical_steps_under_load
 
@@ -95,3 +96,30 @@ def test_a_rehearsal_out_of_time_keeps_the_start():
     run = prepared(deck)
     times, critical = critical_steps_under_load(deck, run.mesh, run.model, seconds=0.0)
     assert list(times) == [0.0] and len(critical) == 1  # the start
+
+
+ROLLUP_STATIC = ROOT / "decks" / "verification" / "test04_strip_rollup_static.toml"
+
+
+def test_a_static_solve_rehearsed_to_its_end_is_forecast_as_the_run_takes_it(monkeypatch):
+    """The strip rolled up statically takes 15 iterations and 8 tangents a load step,
+    twice and eight times what the shipped decks' pace counts: rehearsed to its end, the
+    forecast is the run's own steps, iterations and tangents (a deterministic solve). No
+    time limit here, so a busy machine cannot cut the rehearsal short."""
+    monkeypatch.setattr(rehearsal, "REHEARSAL_SECONDS", math.inf)
+    deck = parse_deck(ROLLUP_STATIC.read_text())
+    run = prepared(deck, ROLLUP_STATIC.parent)
+    ahead = forecast(deck, run.mesh, run.model)
+    taken = run_deck(deck, ROLLUP_STATIC.parent)
+    steps = len(taken.newton)
+    assert ahead["rehearsed"] and ahead["steps"] == steps == taken.sim.state.steps
+    assert ahead["pace"] == (sum(s.iterations for s in taken.newton) / steps, len(taken.tangent_seconds) / steps)
+    assert ahead["pace"][1] > 2 * NEWTON_PACE["load"][1]  # what the shipped pace would have missed
+
+
+def test_a_newton_rehearsal_out_of_time_is_forecast_at_the_shipped_pace(monkeypatch):
+    monkeypatch.setattr(rehearsal, "REHEARSAL_SECONDS", 0.0)
+    deck = parse_deck(ROLLUP_STATIC.read_text())
+    run = prepared(deck, ROLLUP_STATIC.parent)
+    ahead = forecast(deck, run.mesh, run.model)
+    assert not ahead["rehearsed"] and ahead["steps"] == newton_steps(deck) and ahead["pace"] == NEWTON_PACE["load"]

@@ -206,6 +206,11 @@ def needs_calibration(model) -> bool:
     return bool(_with(model, "calibrate"))
 
 
+def without(model, kind):
+    """``model`` with ``kind``'s loads (a module of KINDS that carries a bundle) left out."""
+    return model._replace(loads=model.loads._replace(**{kind.__name__.rsplit(".", 1)[1]: None}))
+
+
 def step_share(model) -> float:
     """The share of the structure's critical step that stays stable with every penalty."""
     return min((kind.step_share(bundle) for kind, bundle in _with(model, "step_share")), default=1.0)

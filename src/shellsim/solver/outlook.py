@@ -4,7 +4,7 @@ refused with the numbers that say why.
 
 A forecast times the scene itself (docs/verification.md, "Cost of a scene"): the explicit
 loop's parts on the prepared scene at rest, counted as the loop will take them with the
-step following the loads (:mod:`.rehearsal`); a Newton path's tangent and residual. Only
+step following the loads (:mod:`.rehearsal`); a Newton path's own solve, rehearsed. Only
 refusing a hopeless scene, before anything is built, goes by a rate: one step of a group
 of 16 elements takes about 130 us on one thread on this project's reference machine. The
 memory a run holds is :mod:`shellsim.memory`'s.
@@ -34,7 +34,7 @@ from ..loads import ToolForces, stable_step
 from .equilibrium import warmed
 from .simulation import Simulation
 from .sparse_lu import SymmetricPatternLU
-from .rehearsal import REHEARSAL_ELEMENTS, REHEARSAL_SECONDS, critical_steps_under_load
+from .rehearsal import REHEARSAL_ELEMENTS, REHEARSAL_SECONDS, critical_steps_under_load, newton_rehearsal
 from .timestep import MARGIN_SHARE, EstimateSchedule
 
 if TYPE_CHECKING:
@@ -267,10 +267,14 @@ def _quickest(work: Callable[[], None], repeats: int = 2) -> float:
 
 
 #: Each Newton path's (iterations, tangents) per load or time step, as the shipped decks
-#: took them on average (benchmarks/forecasts.py): load control 7.8-11.5 iterations and
-#: 0.3-3 tangents (the carotid, the cantilever), arc length 2.3-3.2 and 1.9-2.7 (the
-#: balloon, the hinged roofs), implicit 10.9 and 3.6 (the aortic valve).
-NEWTON_PACE = {"load": (8.0, 1.0), "arc_length": (3.0, 3.0), "implicit": (11.0, 3.6)}
+#: took them (benchmarks/forecasts.py), every tangent formed counted: the stability
+#: checks' and those of tries cut back too. Load control 3-15 iterations and 0.35-8
+#: tangents (the hemisphere to the rolled-up strip), 8 and 1 taken: the carotid's 11.5
+#: and 0.35, the one deck too large to rehearse to its end, are what a large scene's
+#: modified Newton steps take; arc length 2.3-3.2 and 2.0-2.8 (the balloon, the hinged
+#: roofs); implicit 11.2 and 5.1 (the aortic valve: 462 tangents formed in 91 steps, 317
+#: of them in the tries that converged).
+NEWTON_PACE = {"load": (8.0, 1.0), "arc_length": (3.0, 3.0), "implicit": (11.0, 5.1)}
 #: Arc length takes about this many steps per output landing or first increment (the
 #: hinged roofs 1.8 and 2.0, the balloon 4.1).
 ARC_STEPS = 2.0
@@ -298,19 +302,43 @@ def newton_steps(deck: Deck) -> int:
 def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], None] | None = None,
              announce: Callable[[str], None] = lambda text: None) -> dict:
     """What a run of ``deck`` on ``model`` will take: ``steps`` and ``seconds`` (and the
-    outlook they come from: :func:`step_outlook`'s for the explicit path; for a Newton
-    path :func:`static_outlook`'s, its time per tangent as ``tangent_seconds``, and the
-    iterations and tangents per step it counts on, NEWTON_PACE's, as ``pace``). The
-    model's penalty springs are left set as a run's :func:`~.run.prepare` sets them."""
+    outlook they come from: :func:`step_outlook`'s for the explicit path, :func:`newton_outlook`'s
+    for a Newton path). The model's penalty springs are left set as a run's
+    :func:`~.run.prepare` sets them."""
     if deck.solver.method == "explicit":
         return step_outlook(deck, mesh, model, on_product, announce)
+    return newton_outlook(deck, mesh, model, announce)
+
+
+def newton_outlook(deck: Deck, mesh: Mesh, model: Model, announce: Callable[[str], None] = lambda text: None) -> dict:
+    """A static or implicit run's ``steps`` and ``seconds``, and :func:`static_outlook`'s
+    timings. On scenes of up to REHEARSAL_ELEMENTS elements the deck's own solve is
+    rehearsed for REHEARSAL_SECONDS (:func:`.rehearsal.newton_rehearsal`): one that ends
+    in that time is what the run takes (``rehearsed`` True; ``pace`` the iterations and
+    tangents a step it took). Otherwise a step to each output time (:func:`newton_steps`),
+    each at NEWTON_PACE's iterations and tangents (``pace``); a tangent costs
+    ``tangent_seconds``, what the rehearsal's took as the scene deformed (the valve's
+    0.26 s against 0.15 s formed at rest), or one formed at rest and factorised where
+    none was, and an iteration a residual timed at rest (``residual_seconds``) and
+    ITERATION_SECONDS. The rehearsal's pace itself tells little of the rest: the
+    carotid's first four steps took half its run's time, forming the tangents its
+    modified Newton steps then keep."""
     outlook = static_outlook(model)
+    tangent = outlook["seconds"]
+    if model.n_elements <= REHEARSAL_ELEMENTS:
+        announce(f"rehearsing the solve (at most {REHEARSAL_SECONDS:g} s)")
+        rehearsed = newton_rehearsal(deck, mesh, model)
+        if rehearsed["finished"] and rehearsed["steps"]:
+            steps = rehearsed["steps"]
+            pace = (rehearsed["iterations"] / steps, rehearsed["tangents"] / steps)
+            return outlook | {"steps": steps, "seconds": rehearsed["seconds"], "tangent_seconds": tangent,
+                              "pace": pace, "rehearsed": True}
+        tangent = rehearsed["tangent_seconds"] or tangent
     steps = newton_steps(deck)
     iterations, tangents = pace = NEWTON_PACE[newton_path(deck)]
-    per_step = tangents * outlook["seconds"] + iterations * (outlook["residual_seconds"] + ITERATION_SECONDS)
-    checks = 2 if deck.solver.method == "static" and deck.solver.static.check_stability else 0  # start, end
-    return outlook | {"steps": steps, "seconds": steps * per_step + checks * outlook["seconds"],
-                      "tangent_seconds": outlook["seconds"], "pace": pace}
+    per_step = tangents * tangent + iterations * (outlook["residual_seconds"] + ITERATION_SECONDS)
+    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": tangent, "pace": pace,
+                      "rehearsed": False}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:

@@ -1,14 +1,19 @@
-"""The critical step as an explicit deck's loads act, foreseen before the run: the deck's
-loads followed quasi-statically (a static solve of the same scene, loosely converged) and
-the structure's critical step estimated at each converged state.
+"""A run's course foreseen before it starts, by rehearsing it for a few seconds.
 
-An explicit run's step follows its structure: tissue stiffens as it stretches (the Lee-Sacks
-flap's step fell 8.7 times at 20 mmHg), a sheet thins, contact adds its springs. The step at
-rest alone forecast 2,655 steps where the flap took 11,023. A static solve finds the loaded
-states in a few dozen Newton steps where the run takes thousands; the dynamics' own
-overshoot is left out. The rehearsal stops at REHEARSAL_SECONDS, or where the static solve
-cannot go on (a slack chord, spreading contact, a load past the structure's limit): the
-steps beyond hold the last critical step found.
+An explicit deck's critical step as its loads act: the loads followed quasi-statically
+(a static solve of the same scene, loosely converged) and the structure's critical step
+estimated at each converged state. An explicit run's step follows its structure: tissue
+stiffens as it stretches (the Lee-Sacks flap's step fell 8.7 times at 20 mmHg), a sheet
+thins, contact adds its springs. The step at rest alone forecast 2,655 steps where the
+flap took 11,023. A static solve finds the loaded states in a few dozen Newton steps where
+the run takes thousands; the dynamics' own overshoot is left out. The rehearsal stops at
+REHEARSAL_SECONDS, or where the static solve cannot go on (a slack chord, spreading
+contact, a load past the structure's limit): the steps beyond hold the last critical step
+found.
+
+A static or implicit deck's own solve, timed (:func:`newton_rehearsal`): its iterations
+and tangents follow the path (the strip rolled up statically takes 8 tangents a step, the
+hinged roofs' arc lengths 3), and its tangents' cost the scene as it deforms.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ import numpy as np
 
 from ..deck import Deck
 from ..errors import ShellsimError
-from ..loads import stable_step
+from ..loads import shell_contact, stable_step, without
 from ..mesh import Mesh
 from ..model import Model
 from .equilibrium import warmed
@@ -44,7 +49,13 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
     and the cables' share included, :func:`shellsim.loads.stable_step`) at the start and
     at each state a static solve of the deck's loads converged on within ``seconds``
     (REHEARSAL_SECONDS by default), in time order. Nothing the static solve meets stops
-    the forecast: it ends the rehearsal."""
+    the forecast: it ends the rehearsal. Contact between shells is left out of the solve:
+    a static path stalls as it spreads (the closing valve's did not get past its first
+    step in 38 s), while the tissue's stiffening, which sets the step, comes from the
+    stretch the loads give, and the leaflets pressed through each other stretch as much
+    or more (without it the valve's beat is followed to t = 0.725 in 25 s unbounded, its
+    step falling 6 times under 80 mmHg). Where such contact carries the
+    load, the solve without it finds no equilibrium, and the step at rest holds."""
     from .run import Listener, prepare
     from .static_solve import solve_static
 
@@ -62,14 +73,51 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
             sim = run.sim
             sim.update_masses()
             times.append(sim.state.t)
-            critical.append(stable_step(run.model, sim.state.fields.shape, sim.critical_time_step(), sim.mass_factor))
+            critical.append(stable_step(model, sim.state.fields.shape, sim.critical_time_step(), sim.mass_factor))
             if time.perf_counter() > stop:
                 raise _Spent
 
+    apart = without(model, shell_contact)  # the contacts' share of the step is still the deck's
     try:
-        warmed(model)  # the budget is the solve's, not the kernels' loading
+        warmed(apart)  # the budget is the solve's, not the kernels' loading
         stop = time.perf_counter() + (REHEARSAL_SECONDS if seconds is None else seconds)
-        solve_static(prepare(rehearsal, mesh, model), Estimates())
+        solve_static(prepare(rehearsal, mesh, apart), Estimates())
     except (_Spent, ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError):
         pass  # the states found until then
     return np.asarray(times), np.asarray(critical)
+
+
+def newton_rehearsal(deck: Deck, mesh: Mesh, model: Model, seconds: float | None = None) -> dict:
+    """The deck's own static or implicit solve, run for at most ``seconds``
+    (REHEARSAL_SECONDS by default) and timed: ``steps`` converged, the clock ``t`` they
+    reached, the ``seconds`` they took (the solve's alone, its kernels loaded first),
+    their ``iterations``, the ``tangents`` formed (stability checks' and cut-back tries'
+    too), ``tangent_seconds`` a tangent formed and
+    factorised took on average (None: none was), and whether the solve ``finished`` (it
+    reached the end, or stopped on its own: a run would too). A tangent's cost follows the
+    scene as it deforms (the follower pressure's and contact's parts, their fill of the
+    factors), which a tangent timed at rest does not see."""
+    from .implicit import solve_implicit
+    from .run import Listener, prepare
+    from .static_solve import solve_static
+
+    class Spending(Listener):
+        def on_sample(self, run) -> None:
+            if time.perf_counter() > stop:
+                raise _Spent
+
+    run = prepare(deck, mesh, model)
+    warmed(model)
+    finished = True
+    start = time.perf_counter()
+    stop = start + (REHEARSAL_SECONDS if seconds is None else seconds)
+    try:
+        (solve_implicit if deck.solver.method == "implicit" else solve_static)(run, Spending())
+    except _Spent:
+        finished = False
+    except (ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError):
+        pass  # a run stops there too
+    return {"steps": len(run.newton), "t": float(run.sim.state.t), "seconds": time.perf_counter() - start,
+            "iterations": sum(step.iterations for step in run.newton),
+            "tangents": len(run.tangent_seconds), "finished": finished,
+            "tangent_seconds": float(np.mean(run.tangent_seconds)) if run.tangent_seconds else None}

@@ -79,6 +79,7 @@ class Run:
     lowest: Worst | None = None  # the worst element seen over the run
     breaking_frame: float | None = None  # time of the frame written as the run broke down
     newton: list = field(default_factory=list)  # a static solve's converged load steps (static.NewtonStep)
+    tangent_seconds: list[float] = field(default_factory=list)  # each tangent a Newton path formed and factorised [s]
     stability: object | None = None  # a static solve's watch of its tangent's pivots (stability.StabilityWatch)
     relaxing: Relaxing | None = None  # a dynamic relaxation's watch for rest
     unloading: object | None = None  # finding an imaged scene's unloaded shape (unloaded.Unloading)

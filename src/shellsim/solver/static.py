@@ -22,6 +22,7 @@ times.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,12 +124,15 @@ class NewtonSolver:
         """(tangent (n_free, size), the LU factors of its free columns, its round-off
         floor) at the last evaluation; ``at_converged``: the evaluation is of the converged
         state, whose stability the factors' pivots are recorded as. Raises
-        SingularTangent, naming the nodes with no stiffness, when it has no factors."""
+        SingularTangent, naming the nodes with no stiffness, when it has no factors. The
+        wall time of forming and factorising it is added to ``run.tangent_seconds``."""
+        start = time.perf_counter()
         tangent = self.eq.tangent()
         try:
             lu = SymmetricPatternLU(tangent[:, :self.n_free])
         except RuntimeError as error:  # "Factor is exactly singular"
             raise SingularTangent(f"the tangent stiffness is singular ({error}){self._stiffless(tangent)}") from None
+        self.run.tangent_seconds.append(time.perf_counter() - start)
         if at_converged:
             self.stability.observe(self.eq.converged.t, self.run.load_time, lu.negative_pivots)
         return tangent, lu, self.round_off(tangent)

@@ -118,3 +118,22 @@ def test_the_usable_cpus_follow_the_affinity_mask(monkeypatch):
     assert usable_cpus() == 2
     monkeypatch.setattr("shellsim.threads.cgroup_cpus", lambda: 0.2)
     assert usable_cpus() == 1
+
+
+def test_the_critical_step_is_estimated_on_the_count_the_steps_were_chosen_to_run_on(monkeypatch):
+    """On a busy machine the chooser takes the steps to one thread; the estimates between
+    them follow, rather than stalling on every thread."""
+    import numba
+
+    from shellsim.deck import parse_deck
+    from shellsim.solver import simulation
+
+    from .conftest import CLAMPED_PLATE, deck_text, prepared
+
+    sim = prepared(parse_deck(deck_text(*CLAMPED_PLATE))).sim
+    counts = []
+    monkeypatch.setattr(simulation, "critical_time_step",
+                        lambda *args: (counts.append(numba.get_num_threads()), (1.0, None))[1])
+    sim.threads.current = 1
+    sim.critical_time_step()
+    assert counts == [1]

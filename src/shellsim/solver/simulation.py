@@ -126,8 +126,11 @@ class Simulation:
 
     def critical_time_step(self, on_product: Callable[[int], None] | None = None) -> float:
         """dt_critical = 2 / omega_max at the current state (Lanczos, from the last eigenvector after the first);
-        ``on_product(count)`` hears of each stiffness product."""
-        dt, self.eigenvector = critical_time_step(self, self.eigenvector, on_product, self.fresh)
+        ``on_product(count)`` hears of each stiffness product. Its products run on the
+        thread count the steps run on now: on a busy machine, where one thread was
+        chosen, all of them stall the estimate as they stalled the steps."""
+        with kernel_threads(self.threads.current):
+            dt, self.eigenvector = critical_time_step(self, self.eigenvector, on_product, self.fresh)
         return dt
 
     def evaluate_forces(self) -> None:

@@ -67,23 +67,34 @@ def test_a_slack_cable_falls_to_the_exact_elastic_catenary_where_a_static_solve_
     assert 7e-3 < sag < 9e-3 and across < sag
 
 
-def test_check_times_a_tangent_and_its_factors_for_the_implicit_path(tmp_path):
-    """``check`` of the plate as an implicit deck forms a tangent at rest and factorises
-    it, and says how long that took on this machine and what the steps will take at the
-    implicit path's iterations and tangents a step, beside the unknowns (5 per node)."""
+def test_check_times_a_tangent_and_its_factors_for_the_implicit_path(tmp_path, monkeypatch):
+    """``check`` of the plate as an implicit deck rehearses its solve: where that ends in
+    its time, the cost is the rehearsal's steps and pace; where it cannot (no time here),
+    a tangent formed at rest and factorised, timed on this machine, at the implicit
+    path's iterations and tangents a step, beside the unknowns (5 per node)."""
+    import math
     import re
 
     from typer.testing import CliRunner
 
     from shellsim.cli import app
     from shellsim.geometry import build_mesh
+    from shellsim.solver import rehearsal
 
     text = PLATE.read_text().replace("end_time = 0.18", 'end_time = 0.18\nmethod = "implicit"')
     deck = tmp_path / "plate.toml"
     deck.write_text(text)
-    result = CliRunner().invoke(app, ["check", str(deck)], env={"COLUMNS": "60"})
-    said = " ".join(result.output.replace("│", " ").split())
-    assert result.exit_code == 0, result.output
     unknowns = 5 * len(build_mesh(parse_deck(text)).x)
+
+    def said(seconds: float) -> str:
+        monkeypatch.setattr(rehearsal, "REHEARSAL_SECONDS", seconds)
+        result = CliRunner().invoke(app, ["check", str(deck)], env={"COLUMNS": "60"})
+        assert result.exit_code == 0, result.output
+        return " ".join(result.output.replace("│", " ").split())
+
+    timed = said(0.0)
     assert re.search(rf"{unknowns:,} unknowns; about [\d,]+ steps and [\d.e+-]+ (s|min|h) on this machine \(at 11 "
-                     r"iterations and 3.6 tangents a step.*: [\d.e+-]+ (s|min|h) a tangent", said), said
+                     r"iterations and 5.1 tangents a step.*: [\d.e+-]+ (s|min|h) a tangent", timed), timed
+    rehearsed = said(math.inf)
+    assert re.search(rf"{unknowns:,} unknowns; about [\d,]+ steps and [\d.e+-]+ (s|min|h) on this machine \(the solve "
+                     r"rehearsed to its end: [\d.]+ iterations and [\d.e-]+ tangents a step\)", rehearsed), rehearsed

@@ -12,7 +12,7 @@ the entries in the factors, and one solve. Medians of ``--repeat`` runs. With
 displacement of about 3.4 at A, 85 thicknesses) for the wall time per mesh.
 Prints Markdown tables; nothing is asserted.
 
-    .venv/bin/python benchmarks/static_scaling.py [--patches 8 16 23 32 50] [--runs 6 11 23]
+    .venv/bin/python benchmarks/static_scaling.py [--patches 8 16 23 32 50] [--runs 6 11 23] [--no-colamd]
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import os
 import subprocess
 import sys
@@ -71,13 +72,13 @@ print(json.dumps({"elements": run.model.n_elements, "unknowns": n, "entries": k.
 """
 
 
-def operations(patches: list[int], repeat: int) -> None:
+def operations(patches: list[int], repeat: int, colamd: bool) -> None:
     print("| elements | unknowns | tangent entries | forward tangent [s] | central tangent [s] | LU on the diagonal [s] "
-          "| its factors [M] | COLAMD LU [s] | its factors [M] | solve [s] | peak memory [MB] |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "| its factors [M] | COLAMD LU [s] | its factors [M] | solve [s] | peak memory [MB] | per element [kB] |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for patch in patches:
-        r = {}
-        for part in ("solver", "colamd"):
+        r = {"colamd_s": math.nan, "colamd_fill": math.nan}
+        for part in ("solver", "colamd") if colamd else ("solver",):
             done = subprocess.run([sys.executable, "-c", f"ROOT = {str(ROOT)!r}\n" + CHILD, str(DECK), str(patch),
                                    str(repeat), part], capture_output=True, text=True, cwd=ROOT)
             if done.returncode:
@@ -89,7 +90,8 @@ def operations(patches: list[int], repeat: int) -> None:
         pivoted = " (pivoted)" if r["pivoted"] else ""
         print(f"| {r['elements']:,} | {r['unknowns']:,} | {r['entries'] / 1e6:.2f} M | {r['forward_s']:.3f} "
               f"| {r['central_s']:.3f} | {r['factor_s']:.3f}{pivoted} | {r['fill'] / 1e6:.1f} | {r['colamd_s']:.3f} "
-              f"| {r['colamd_fill'] / 1e6:.1f} | {r['solve_s']:.4f} | {r['peak_bytes'] / 1e6:.0f} |", flush=True)
+              f"| {r['colamd_fill'] / 1e6:.1f} | {r['solve_s']:.4f} | {r['peak_bytes'] / 1e6:.0f} "
+              f"| {r['peak_bytes'] / r['elements'] / 1e3:.0f} |", flush=True)
 
 
 def runs(patches: list[int]) -> None:
@@ -123,9 +125,11 @@ def main() -> None:
                         help="patches of the whole nonlinear runs (6, 11, 23: about 8 x 8, 16 x 16, 32 x 32 "
                              "elements on the quarter)")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each operation (the median is shown)")
+    parser.add_argument("--no-colamd", action="store_true",
+                        help="leave out SuperLU's COLAMD (its fill grows as n^2: hours and tens of GB at 10^4 elements)")
     args = parser.parse_args()
     if args.patches:
-        operations(args.patches, args.repeat)
+        operations(args.patches, args.repeat, not args.no_colamd)
     if args.runs:
         print()
         runs(args.runs)

@@ -247,10 +247,12 @@ def test_a_static_summary_states_the_load_reached_and_the_largest_on_the_way():
              for t, load in ((0.1, 0.1), (0.3, 0.3), (0.4, 0.2))]
     factors = SimpleNamespace(columns=["load_factor_ramp"])
     run = SimpleNamespace(newton=steps, stability=None, measure={"load_factors": factors}.get,
-                          history={"load_factor_ramp": [0.0, 0.1, 0.3, 0.2]})
+                          history={"load_factor_ramp": [0.0, 0.1, 0.3, 0.2]},
+                          tangent_seconds=[0.5, 0.25, 0.25, 0.5])  # a try cut back formed one more
     record = static_record(run)
     assert (record["load_time_reached"], record["largest_load_time"]) == (0.2, 0.3)
     assert record["largest_load_factors"] == {"load_factor_ramp": 0.3}
+    assert (record["tangents"], record["tangents_formed"], record["tangent_seconds"]) == (3, 4, 1.5)
 
 
 def test_a_stop_while_the_meshing_child_is_forked_is_not_lost(ctrl_c_delivered):

@@ -101,7 +101,9 @@ def unstarted(scene, deck_path: Path, message: str, status: str = "not converged
 
 def static_record(run: Run) -> dict:
     """A static solve's load steps (an implicit one's time steps): how many, the Newton iterations, tangents formed and
-    cut-backs over them, the largest relative residual a step ended with, the load time
+    cut-backs over them (``tangents``: those of the tries that converged; ``tangents_formed``
+    and their ``tangent_seconds`` [s]: every one, the stability checks' and the cut tries'
+    too), the largest relative residual a step ended with, the load time
     reached at the end and the largest on the way (an arc-length path's clock can end
     short of its load) with each curve's largest load factor, each step, and where the
     path lost or regained stability (:meth:`.stability.StabilityWatch.events`)."""
@@ -112,6 +114,7 @@ def static_record(run: Run) -> dict:
             "largest_load_time": max((s["load_time"] for s in steps), default=0.0),
             "largest_load_factors": {column: max(run.history[column], default=0.0) for column in factors},
             "tangents": sum(s["tangents"] for s in steps),
+            "tangents_formed": len(run.tangent_seconds), "tangent_seconds": sum(run.tangent_seconds),
             "cutbacks": sum(s["cutbacks"] for s in steps),
             "largest_residual": max((s["residual"] for s in steps), default=0.0),
             "stability": run.stability.events() if run.stability is not None else [], "steps": steps}

@@ -50,12 +50,12 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
     at each state a static solve of the deck's loads converged on within ``seconds``
     (REHEARSAL_SECONDS by default), in time order. Nothing the static solve meets stops
     the forecast: it ends the rehearsal. Contact between shells is left out of the solve:
-    a static path stalls as it spreads (the closing valve's did not get past its first
-    step in 38 s), while the tissue's stiffening, which sets the step, comes from the
-    stretch the loads give, and the leaflets pressed through each other stretch as much
-    or more (without it the valve's beat is followed to t = 0.725 in 25 s unbounded, its
-    step falling 6 times under 80 mmHg). Where such contact carries the
-    load, the solve without it finds no equilibrium, and the step at rest holds."""
+    a static path stalls as it spreads (the heartbeat's did not get past its first step
+    in 38 s), while the tissue's stiffening, which sets the step, comes from the stretch
+    the loads give, and leaflets pressed through each other stretch as much or more
+    (without it the heartbeat's loads are followed to t = 0.725 in 25 s, its step falling
+    6 times under 80 mmHg). Where such contact carries the load, the solve without it
+    finds no equilibrium, and the step at rest holds."""
     from .run import Listener, prepare
     from .static_solve import solve_static
 
@@ -92,11 +92,11 @@ def newton_rehearsal(deck: Deck, mesh: Mesh, model: Model, seconds: float | None
     (REHEARSAL_SECONDS by default) and timed: ``steps`` converged, the clock ``t`` they
     reached, the ``seconds`` they took (the solve's alone, its kernels loaded first),
     their ``iterations``, the ``tangents`` formed (stability checks' and cut-back tries'
-    too), ``tangent_seconds`` a tangent formed and
-    factorised took on average (None: none was), and whether the solve ``finished`` (it
-    reached the end, or stopped on its own: a run would too). A tangent's cost follows the
-    scene as it deforms (the follower pressure's and contact's parts, their fill of the
-    factors), which a tangent timed at rest does not see."""
+    too), ``tangent_seconds`` a tangent formed and factorised took on average (None: none
+    was), and whether the solve ``finished`` (it reached the end, or stopped on its own: a
+    run would too). A tangent's cost follows the scene as it deforms (the follower
+    pressure's and contact's parts, their fill of the factors), which a tangent timed at
+    rest does not see."""
     from .implicit import solve_implicit
     from .run import Listener, prepare
     from .static_solve import solve_static

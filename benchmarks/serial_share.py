@@ -10,22 +10,10 @@ on many cores (Amdahl). Prints one line; nothing is asserted.
 from __future__ import annotations
 
 import argparse
-import time
 import tomllib
-from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def best(work: Callable[[], object], repeats: int) -> float:
-    """The shortest wall time [s] of ``repeats`` calls of ``work``."""
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        work()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:
@@ -39,6 +27,7 @@ def main() -> None:
     from shellsim.deck import deck_from_data
     from shellsim.element.assembly import _gather_at_nodes
     from shellsim.execute import built_run
+    from shellsim.solver.outlook import quickest
 
     data = tomllib.loads((ROOT / "decks" / "bench" / "plate_step.toml").read_text())
     data["mesh"]["divisions"] = {"length": args.divisions, "width": args.divisions}
@@ -47,10 +36,10 @@ def main() -> None:
     dt = sim.critical_time_step() / 1.25
     sim.advance(5 * dt, dt, 5)
     steps = 50
-    step = best(lambda: sim.advance(sim.state.t + steps * dt, dt, steps), 5) / steps
-    forces = best(lambda: sim.compute_forces(sim.state.t), 20)
+    step = quickest(lambda: sim.advance(sim.state.t + steps * dt, dt, steps), 5) / steps
+    forces = quickest(lambda: sim.compute_forces(sim.state.t), 20)
     nodal = sim.state.fields.f_int.copy()
-    gather = best(lambda: _gather_at_nodes(sim.model.body, sim.workspace.parts, nodal), 20)
+    gather = quickest(lambda: _gather_at_nodes(sim.model.body, sim.workspace.parts, nodal), 20)
     per = 1e6 / sim.model.n_elements
     print(f"{sim.model.n_elements:,} elements, {args.threads} thread(s): a step {per * step:.2f} us per element, "
           f"its forces {per * forces:.2f}, the nodal gather {per * gather:.3f}; outside the forces "

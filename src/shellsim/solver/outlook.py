@@ -93,9 +93,9 @@ def loop_costs(run: Run, dt: float, mass_factor: float = 1.0) -> dict:
     sim, quiet = run.sim, Listener()
     sim.mass_factor = mass_factor
     update_time_step(run, quiet)
-    estimate = _quickest(lambda: update_time_step(run, quiet), 1)
+    estimate = quickest(lambda: update_time_step(run, quiet), 1)
     run.dt = dt
-    sample = _quickest(lambda: (take_sample(run, quiet), check_unstable(run)), 3)
+    sample = quickest(lambda: (take_sample(run, quiet), check_unstable(run)), 3)
     end = run.deck.solver.end_time  # a finite stop: toward an infinite one each step took 50 times as long
     sim.advance(end, dt, 2)  # the first call may load the kernels
     steps, start = 0, time.perf_counter()
@@ -105,7 +105,7 @@ def loop_costs(run: Run, dt: float, mass_factor: float = 1.0) -> dict:
             break
         steps += taken
     step = (time.perf_counter() - start) / steps if steps else 0.0
-    single = _quickest(lambda: sim.advance(end, dt, 1), 5)
+    single = quickest(lambda: sim.advance(end, dt, 1), 5)
     return {"step": step, "call": max(single - step, 0.0), "sample": sample, "estimate": estimate}
 
 
@@ -252,11 +252,11 @@ def static_outlook(model: Model) -> dict:
         with suppress(RuntimeError):  # singular at rest (a slack chord's nodes): the forming's time alone
             SymmetricPatternLU(tangent[:, :equilibrium.unknowns.n_free])
 
-    return {"unknowns": 5 * model.n_nodes, "seconds": _quickest(factorised),
-            "residual_seconds": _quickest(lambda: equilibrium.evaluate(0.0)), "bytes": memory_bytes(model.n_elements)}
+    return {"unknowns": 5 * model.n_nodes, "seconds": quickest(factorised),
+            "residual_seconds": quickest(lambda: equilibrium.evaluate(0.0)), "bytes": memory_bytes(model.n_elements)}
 
 
-def _quickest(work: Callable[[], None], repeats: int = 2) -> float:
+def quickest(work: Callable[[], None], repeats: int = 2) -> float:
     """The shortest wall time [s] of ``repeats`` calls of ``work``: the least disturbed."""
     times = []
     for _ in range(repeats):

@@ -126,7 +126,7 @@ def main() -> None:
                              "elements on the quarter)")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each operation (the median is shown)")
     parser.add_argument("--no-colamd", action="store_true",
-                        help="leave out SuperLU's COLAMD (its fill grows as n^2: hours and tens of GB at 10^4 elements)")
+                        help="leave out SuperLU's COLAMD (its time grew as n^2.1 to 19.5 s at 5,000 elements)")
     args = parser.parse_args()
     if args.patches:
         operations(args.patches, args.repeat, not args.no_colamd)

@@ -28,11 +28,12 @@ def main() -> None:
     from shellsim.element.assembly import _gather_at_nodes
     from shellsim.execute import built_run
     from shellsim.solver.outlook import quickest
+    from shellsim.threads import ThreadChooser
 
     data = tomllib.loads((ROOT / "decks" / "bench" / "plate_step.toml").read_text())
     data["mesh"]["divisions"] = {"length": args.divisions, "width": args.divisions}
     sim = built_run(deck_from_data(data), ROOT).sim
-    sim.threads.counts = (args.threads,)  # the count asked, never the chooser's other
+    sim.threads = ThreadChooser(args.threads, choose=False)  # the count asked, never the other
     dt = sim.critical_time_step() / 1.25
     sim.advance(5 * dt, dt, 5)
     steps = 50

@@ -420,12 +420,11 @@ def _newton_cost(outlook: dict) -> str:
     from .solver.outlook import duration
 
     iterations, tangents = outlook["pace"]
-    timed = (f"{duration(outlook['tangent_seconds'])} a tangent, {duration(outlook['residual_seconds'])} a residual, "
-             "timed at rest")
     basis = (f"the solve rehearsed to its end: {iterations:.3g} iterations and {tangents:.3g} tangents a step"
              if outlook["rehearsed"] else
-             f"at {iterations:g} iterations and {tangents:g} tangents a step, as the shipped decks took them: {timed}; "
-             "a stiffening or contacting scene takes more")
+             f"at {iterations:g} iterations and {tangents:g} tangents a step, as the shipped decks took them: "
+             f"{duration(outlook['tangent_seconds'])} a tangent ({outlook['tangent_timed']}), "
+             f"{duration(outlook['residual_seconds'])} a residual at rest; a stiffening or contacting scene takes more")
     return (f"{outlook['unknowns']:,} unknowns; about {outlook['steps']:,} steps and {duration(outlook['seconds'])} "
             f"on this machine ({basis}), {size_text(outlook['bytes'])} of memory")
 

@@ -238,13 +238,19 @@ def _critical_under_load(deck: Deck, mesh: Mesh, model: Model, at_rest: float,
                              "rehearsed_to": float(times[-1]) if len(times) > 1 else None}
 
 
+def newton_holds(model: Model) -> dict:
+    """What a static or implicit solve of ``model`` holds: ``unknowns`` (5 DOF per node,
+    supports' included) and ``bytes``."""
+    return {"unknowns": 5 * model.n_nodes, "bytes": memory_bytes(model.n_elements)}
+
+
 def static_outlook(model: Model) -> dict:
-    """What a static or implicit solve will hold and cost per tangent: ``unknowns`` (5 DOF
-    per node, supports' included), ``residual_seconds`` to evaluate the residual once (an
+    """What a static or implicit solve will hold (:func:`newton_holds`) and cost per
+    tangent: ``residual_seconds`` to evaluate the residual once (an
     iteration's main cost), ``seconds`` to form a tangent at rest and factorise it
     on this machine's threads (timed: the rate per element said 0.056 s where the aortic
     valve's tangent and factors took 0.22 s, the follower pressure's and the contact's
-    tangents and the factors left out), ``bytes``."""
+    tangents and the factors left out)."""
     equilibrium = warmed(model)
 
     def factorised() -> None:
@@ -252,8 +258,8 @@ def static_outlook(model: Model) -> dict:
         with suppress(RuntimeError):  # singular at rest (a slack chord's nodes): the forming's time alone
             SymmetricPatternLU(tangent[:, :equilibrium.unknowns.n_free])
 
-    return {"unknowns": 5 * model.n_nodes, "seconds": quickest(factorised),
-            "residual_seconds": quickest(lambda: equilibrium.evaluate(0.0)), "bytes": memory_bytes(model.n_elements)}
+    return newton_holds(model) | {"seconds": quickest(factorised),
+                                  "residual_seconds": quickest(lambda: equilibrium.evaluate(0.0))}
 
 
 def quickest(work: Callable[[], None], repeats: int = 2) -> float:
@@ -311,34 +317,36 @@ def forecast(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int], N
 
 
 def newton_outlook(deck: Deck, mesh: Mesh, model: Model, announce: Callable[[str], None] = lambda text: None) -> dict:
-    """A static or implicit run's ``steps`` and ``seconds``, and :func:`static_outlook`'s
-    timings. On scenes of up to REHEARSAL_ELEMENTS elements the deck's own solve is
-    rehearsed for REHEARSAL_SECONDS (:func:`.rehearsal.newton_rehearsal`): one that ends
-    in that time is what the run takes (``rehearsed`` True; ``pace`` the iterations and
-    tangents a step it took). Otherwise a step to each output time (:func:`newton_steps`),
-    each at NEWTON_PACE's iterations and tangents (``pace``); a tangent costs
+    """A static or implicit run's ``steps`` and ``seconds``, and what it holds
+    (:func:`newton_holds`). On scenes of up to REHEARSAL_ELEMENTS elements the deck's own
+    solve is rehearsed for REHEARSAL_SECONDS (:func:`.rehearsal.newton_rehearsal`): one
+    that ends in that time is what the run takes (``rehearsed`` True; ``pace`` the
+    iterations and tangents a step it took). Otherwise, with :func:`static_outlook`'s
+    timings, a step to each output time (:func:`newton_steps`), each at NEWTON_PACE's
+    iterations and tangents (``pace``); a tangent costs
     ``tangent_seconds``, what the rehearsal's took as the scene deformed (the valve's
     0.26 s against 0.15 s formed at rest), or one formed at rest and factorised where
-    none was, and an iteration a residual timed at rest (``residual_seconds``) and
+    none was (``tangent_timed`` says which), and an iteration a residual timed at rest (``residual_seconds``) and
     ITERATION_SECONDS. The rehearsal's pace itself tells little of the rest: the
     carotid's first four steps took half its run's time, forming the tangents its
     modified Newton steps then keep."""
-    outlook = static_outlook(model)
-    tangent = outlook["seconds"]
+    rehearsed = {"tangent_seconds": None}
     if model.n_elements <= REHEARSAL_ELEMENTS:
         announce(f"rehearsing the solve (at most {REHEARSAL_SECONDS:g} s)")
         rehearsed = newton_rehearsal(deck, mesh, model)
         if rehearsed["finished"] and rehearsed["steps"]:
             steps = rehearsed["steps"]
             pace = (rehearsed["iterations"] / steps, rehearsed["tangents"] / steps)
-            return outlook | {"steps": steps, "seconds": rehearsed["seconds"], "tangent_seconds": tangent,
-                              "pace": pace, "rehearsed": True}
-        tangent = rehearsed["tangent_seconds"] or tangent
+            return newton_holds(model) | {"steps": steps, "seconds": rehearsed["seconds"], "pace": pace,
+                                          "rehearsed": True}
+    outlook = static_outlook(model)  # timed at rest only where the rehearsal did not tell it all
+    tangent = rehearsed["tangent_seconds"] or outlook["seconds"]
+    timed = "as the rehearsal's first steps formed them" if rehearsed["tangent_seconds"] else "formed at rest"
     steps = newton_steps(deck)
     iterations, tangents = pace = NEWTON_PACE[newton_path(deck)]
     per_step = tangents * tangent + iterations * (outlook["residual_seconds"] + ITERATION_SECONDS)
-    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": tangent, "pace": pace,
-                      "rehearsed": False}
+    return outlook | {"steps": steps, "seconds": steps * per_step, "tangent_seconds": tangent, "tangent_timed": timed,
+                      "pace": pace, "rehearsed": False}
 
 
 def refuse_if_hopeless(deck: Deck, n_elements: int, dt: float) -> None:

@@ -18,7 +18,6 @@ hinged roofs' arc lengths 3), and its tangents' cost the scene as it deforms.
 
 from __future__ import annotations
 
-import math
 import time
 
 import numpy as np
@@ -43,6 +42,35 @@ class _Spent(Exception):
     """The rehearsal's wall time is used up."""
 
 
+#: What stops a rehearsed solve as it would stop the run: the rehearsal ends there.
+SOLVE_STOPS = (ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError)
+
+
+def _within(seconds: float | None, solve, run, on_sample=lambda run: None) -> tuple[bool, float]:
+    """``solve(run, listener)`` with the run's kernels loaded first, until it ends or
+    ``seconds`` (REHEARSAL_SECONDS by default) are spent, as checked at each sample after
+    ``on_sample(run)``: (whether it ended on its own, the wall time [s] it took)."""
+    from .run import Listener
+
+    class Budget(Listener):
+        def on_sample(self, run) -> None:
+            on_sample(run)
+            if time.perf_counter() > stop:
+                raise _Spent
+
+    start = stop = time.perf_counter()
+    try:
+        warmed(run.model)  # the budget is the solve's, not the kernels' loading
+        start = time.perf_counter()
+        stop = start + (REHEARSAL_SECONDS if seconds is None else seconds)
+        solve(run, Budget())
+    except _Spent:
+        return False, time.perf_counter() - start
+    except SOLVE_STOPS:
+        pass  # a run stops there too
+    return True, time.perf_counter() - start
+
+
 def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
                               seconds: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(times (k,), critical (k,)): the structure's critical step [time] (the contacts'
@@ -56,7 +84,7 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
     (without it the heartbeat's loads are followed to t = 0.725 in 25 s, its step falling
     6 times under 80 mmHg). Where such contact carries the load, the solve without it
     finds no equilibrium, and the step at rest holds."""
-    from .run import Listener, prepare
+    from .run import prepare
     from .static_solve import solve_static
 
     end = deck.solver.end_time
@@ -66,24 +94,15 @@ def critical_steps_under_load(deck: Deck, mesh: Mesh, model: Model,
     output = deck.output.model_copy(update={"interval": None, "times": list(np.linspace(0.0, end, REHEARSAL_LANDINGS + 1)[1:])})
     rehearsal = deck.model_copy(update={"solver": solver, "output": output})
     times, critical = [], []
-    stop = math.inf
 
-    class Estimates(Listener):
-        def on_sample(self, run) -> None:
-            sim = run.sim
-            sim.update_masses()
-            times.append(sim.state.t)
-            critical.append(stable_step(model, sim.state.fields.shape, sim.critical_time_step(), sim.mass_factor))
-            if time.perf_counter() > stop:
-                raise _Spent
+    def estimate(run) -> None:
+        sim = run.sim
+        sim.update_masses()
+        times.append(sim.state.t)
+        critical.append(stable_step(model, sim.state.fields.shape, sim.critical_time_step(), sim.mass_factor))
 
     apart = without(model, shell_contact)  # the contacts' share of the step is still the deck's
-    try:
-        warmed(apart)  # the budget is the solve's, not the kernels' loading
-        stop = time.perf_counter() + (REHEARSAL_SECONDS if seconds is None else seconds)
-        solve_static(prepare(rehearsal, mesh, apart), Estimates())
-    except (_Spent, ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError):
-        pass  # the states found until then
+    _within(seconds, solve_static, prepare(rehearsal, mesh, apart), estimate)  # the states found until it ends
     return np.asarray(times), np.asarray(critical)
 
 
@@ -98,26 +117,12 @@ def newton_rehearsal(deck: Deck, mesh: Mesh, model: Model, seconds: float | None
     pressure's and contact's parts, their fill of the factors), which a tangent timed at
     rest does not see."""
     from .implicit import solve_implicit
-    from .run import Listener, prepare
+    from .run import prepare
     from .static_solve import solve_static
 
-    class Spending(Listener):
-        def on_sample(self, run) -> None:
-            if time.perf_counter() > stop:
-                raise _Spent
-
     run = prepare(deck, mesh, model)
-    warmed(model)
-    finished = True
-    start = time.perf_counter()
-    stop = start + (REHEARSAL_SECONDS if seconds is None else seconds)
-    try:
-        (solve_implicit if deck.solver.method == "implicit" else solve_static)(run, Spending())
-    except _Spent:
-        finished = False
-    except (ShellsimError, ArithmeticError, RuntimeError, ValueError, np.linalg.LinAlgError):
-        pass  # a run stops there too
-    return {"steps": len(run.newton), "t": float(run.sim.state.t), "seconds": time.perf_counter() - start,
+    finished, spent = _within(seconds, solve_implicit if deck.solver.method == "implicit" else solve_static, run)
+    return {"steps": len(run.newton), "t": float(run.sim.state.t), "seconds": spent,
             "iterations": sum(step.iterations for step in run.newton),
             "tangents": len(run.tangent_seconds), "finished": finished,
             "tangent_seconds": float(np.mean(run.tangent_seconds)) if run.tangent_seconds else None}

@@ -9,7 +9,7 @@ what it formed before), its LU factors on the diagonal (the solver's,
 solver's before; in a process of its own, so that the peak memory shown is the solver's),
 the entries in the factors, and one solve. Medians of ``--repeat`` runs. With
 ``--runs``, whole nonlinear runs of the deck with its forces times 10^5 (a radial
-displacement of about 3.4 at A, 85 thicknesses) for the wall time per mesh.
+displacement of about 3.4 at A, 85 thicknesses) for the wall time and peak memory per mesh.
 Prints Markdown tables; nothing is asserted.
 
     .venv/bin/python benchmarks/static_scaling.py [--patches 8 16 23 32 50] [--runs 6 11 23] [--no-colamd]
@@ -40,6 +40,7 @@ from shellsim.deck import deck_from_data
 from shellsim.execute import built_run
 from shellsim.solver.equilibrium import Equilibrium
 from shellsim.solver.sparse_lu import SymmetricPatternLU
+from shellsim.solver.tangent_pattern import free_columns
 deck_path, patch, repeat, part = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 data = tomllib.loads(open(deck_path).read())
 data["mesh"]["divisions"]["patch"] = patch
@@ -56,7 +57,7 @@ def median_seconds(work):
     return statistics.median(times), result
 eq.tangent()  # the first call loads the kernel
 forward, k = median_seconds(eq.tangent)
-k = k[:, :n].tocsc()
+k = free_columns(k, n)  # as the solver takes it
 if part == "colamd":  # SuperLU's default ordering alone, so that its factors stay out of the solver's peak
     colamd, general = median_seconds(lambda: spla.splu(k, permc_spec="COLAMD"))
     print(json.dumps({"colamd_s": colamd, "colamd_fill": general.L.nnz + general.U.nnz}))
@@ -69,6 +70,15 @@ peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"elements": run.model.n_elements, "unknowns": n, "entries": k.nnz, "forward_s": forward,
                   "central_s": central, "factor_s": factor, "fill": lu.entries, "pivoted": lu.pivoted,
                   "solve_s": solve, "peak_bytes": peak}))
+"""
+
+
+#: Runs the command in its arguments and prints its peak memory [bytes] as the last line.
+PEAK_OF = """
+import resource, subprocess, sys
+done = subprocess.run(sys.argv[1:])
+print(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024)
+sys.exit(done.returncode)
 """
 
 
@@ -95,16 +105,18 @@ def operations(patches: list[int], repeat: int, colamd: bool) -> None:
 
 
 def runs(patches: list[int]) -> None:
-    print("| elements | DOFs | load steps | iterations | tangents | wall time of the solve [s] | u_A |")
-    print("|---|---|---|---|---|---|---|")
+    print("| elements | DOFs | load steps | iterations | tangents | wall time of the solve [s] | peak memory [MB] "
+          "| per element [kB] | u_A |")
+    print("|---|---|---|---|---|---|---|---|---|")
     text = DECK.read_text().replace("1.0e-3", repr(1.0e-3 * NONLINEAR))
     text = text[:text.index("[[reference]]")]  # the deck's reference is for its linear forces
     for patch in patches:
         with tempfile.TemporaryDirectory() as folder:
             deck = Path(folder) / "hemisphere.toml"
             deck.write_text(text.replace("patch = 8 }", f"patch = {patch} }}"))
-            done = subprocess.run([sys.executable, "-m", "shellsim", "run", str(deck), "--out",
-                                   str(Path(folder) / "out")], capture_output=True, text=True, cwd=ROOT,
+            # the run in a child of its own, whose peak memory the wrapper reports alone
+            done = subprocess.run([sys.executable, "-c", PEAK_OF, sys.executable, "-m", "shellsim", "run", str(deck),
+                                   "--out", str(Path(folder) / "out")], capture_output=True, text=True, cwd=ROOT,
                                   env=dict(os.environ, COLUMNS="200"))
             if done.returncode:
                 print(f"| patch {patch} | failed: {done.stderr.strip().splitlines()[-1]} |", flush=True)
@@ -112,9 +124,10 @@ def runs(patches: list[int]) -> None:
             summary = json.loads((Path(folder) / "out" / "summary.json").read_text())
             with open(Path(folder) / "out" / "history.csv") as history:
                 u_a = float(list(csv.DictReader(history))[-1]["a_radial"])
-        static = summary["static"]
+        static, peak = summary["static"], float(done.stdout.strip().splitlines()[-1])
         print(f"| {summary['elements']:,} | {5 * summary['nodes']:,} | {static['load_steps']} | {static['iterations']} "
-              f"| {static['tangents']} | {summary['wall_time_s']:.1f} | {u_a:.4f} |", flush=True)
+              f"| {static['tangents']} | {summary['wall_time_s']:.1f} | {peak / 1e6:.0f} "
+              f"| {peak / summary['elements'] / 1e3:.0f} | {u_a:.4f} |", flush=True)
 
 
 def main() -> None:

@@ -6,8 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
+from shellsim.solver import sparse_lu
 from shellsim.solver.sparse_lu import SymmetricPatternLU
+from shellsim.solver.superlu_pivots import store_readable, pivots
 
 
 def laplacian(n: int) -> sp.csc_matrix:
@@ -47,3 +50,37 @@ def test_a_singular_matrix_is_reported():
     a[:, 7] = 0.0
     with pytest.raises(RuntimeError, match="singular"):
         SymmetricPatternLU(sp.csc_matrix(a))
+
+
+def indefinite(n: int, shift: float) -> sp.csc_matrix:
+    """The n x n grid's Laplacian less ``shift`` on its diagonal: symmetric, with as many
+    negative eigenvalues as the Laplacian has below the shift."""
+    return sp.csc_matrix(laplacian(n) - shift * sp.eye(n * n))
+
+
+@pytest.mark.parametrize("shift", [0.0, 0.9, 3.3, 5.1])
+def test_negative_pivots_count_the_negative_eigenvalues(shift):
+    """Sylvester's law of inertia on the diagonal factors, the pivots read from SuperLU's own
+    store: the count of eigenvalues below the shift, from numpy's dense eigenvalues."""
+    a = indefinite(12, shift)
+    lu = SymmetricPatternLU(a)
+    assert not lu.pivoted
+    assert lu.negative_pivots == np.count_nonzero(np.linalg.eigvalsh(a.toarray()) < 0.0)
+
+
+def test_the_pivots_are_read_from_the_store_as_scipys_copy_of_u_holds_them():
+    """The store is readable on this scipy (else every stability check would copy both
+    factors), and what it gives is U's diagonal to the bit, on a matrix of many supernodes."""
+    assert store_readable()
+    a = sp.csc_matrix(indefinite(30, 2.2) + sp.random(900, 900, density=0.002, random_state=3))
+    lu = spla.splu(a, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+    assert np.array_equal(pivots(lu), lu.U.diagonal())
+
+
+def test_unsound_pivots_whose_pivoted_factors_would_not_fit_are_refused(monkeypatch):
+    """The tiny pivots' matrix with no memory to pivot in: refused, saying why, where the
+    general way would have been taken."""
+    monkeypatch.setattr(sparse_lu, "available_bytes", lambda: 1000.0)
+    pair = sp.csc_matrix([[1e-10, 1.0], [1.0, 1e-10]])
+    with pytest.raises(sparse_lu.FactorsTooLarge, match="pivoted factors could need .* where 1 kB is available"):
+        SymmetricPatternLU(sp.csc_matrix(sp.block_diag([laplacian(6)] + [pair] * 10)))

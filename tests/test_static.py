@@ -16,12 +16,14 @@ from typer.testing import CliRunner
 
 from shellsim.cli import app
 from shellsim.deck import load_deck, parse_deck
+from shellsim.element.tangent import ELEMENT_DOFS
 from shellsim.execute import built_run
 from shellsim.geometry import build_mesh
 from shellsim.model import build_model
 from shellsim.solver.equilibrium import Converged, Equilibrium
 from shellsim.solver.run import prepare
 from shellsim.solver.static import NewtonSolver, NewtonStep
+from shellsim.solver.tangent_pattern import free_columns
 from shellsim.verify.analytic import sphere_inflation_path
 
 from .conftest import ROOT, deck_text, run_deck
@@ -152,7 +154,7 @@ def test_every_element_entry_lands_where_a_plain_assembly_puts_it(deck):
     run = panel_run(*PATHS["small strain, total"]) if deck == "panel" else built_run(load_deck(ROOT / deck), ROOT)
     eq = Equilibrium(run.sim)
     u, conn = eq.unknowns, run.sim.model.conn
-    k = np.random.default_rng(2).standard_normal(eq.element_k.shape)
+    k = np.random.default_rng(2).standard_normal((len(conn), ELEMENT_DOFS, ELEMENT_DOFS))
     dofs = u.index[conn].reshape(len(conn), -1)
     rows = np.broadcast_to(dofs[:, :, None], k.shape).ravel()
     cols = np.broadcast_to(dofs[:, None, :], k.shape).ravel()
@@ -162,6 +164,10 @@ def test_every_element_entry_lands_where_a_plain_assembly_puts_it(deck):
     assert u.n_known > 0 or deck == "panel"
     assert ours.nnz == plain.nnz and ours.has_sorted_indices
     assert abs(ours - plain).max() <= 1e-12 * abs(plain).max()
+    # the free columns as the factors take them: the tangent's own arrays, no copy
+    free = free_columns(ours, u.n_free)
+    assert np.shares_memory(free.data, ours.data) and np.shares_memory(free.indices, ours.indices)
+    assert abs(free - plain[:, :u.n_free]).max() <= 1e-12 * abs(plain).max()
 
 
 @pytest.mark.parametrize("path", PATHS)

@@ -198,6 +198,7 @@ class ArcLength:
                 self.load_time, self.forward = t, (1.0 if t >= start else -1.0)
                 self.load_per_length = abs(t - start) / length
                 return iteration, norm / max(scale, 1e-300), t - start
+            lu = None  # the old factors go before the new are formed: together they would double the peak
             _, lu, floor = newton.linearised()
             balance, along = lu.solve(residual), lu.solve(self.rate(t))
             shift = constrained_shift(total[m] + balance[m], along[m], length, total[m])

@@ -60,7 +60,6 @@ class Equilibrium:
         #: the mean element size (a diagonal of each), the unit of the difference steps
         self.element_size = float(np.mean(np.linalg.norm(model.x0[conn[:, 2]] - model.x0[conn[:, 0]], axis=1)))
         self.step_u = STEP_SHARE * self.element_size
-        self.element_k = np.zeros((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         self._t = 0.0
         #: the element tangents: the static element loop's, or one of its own beside a time loop
         self._elements = sim.elements or ElementLoop(sim.response)
@@ -146,7 +145,9 @@ class Equilibrium:
         shape = s.fields.shape
         if self.incremental:  # the increments are measured with the converged lengths
             shape = shape._replace(h=c["h"])
-        k = self.element_k  # every element's block is overwritten: the loads' are added in place
+        # every element's block is overwritten, the loads' added in place; made anew for each
+        # tangent, so that it is gone while the tangent is factorised (16 kB an element)
+        k = np.empty((model.n_elements, ELEMENT_DOFS, ELEMENT_DOFS))
         steps = (self.step_u, STEP_ROTATION) if central else (FORWARD_SHARE * self.element_size, FORWARD_ROTATION)
         converged = (space.dx, space.dd, c["stress"])
         self._elements.tangents(model.structure, shape, converged, steps, central, space.parts, k)
@@ -156,6 +157,7 @@ class Equilibrium:
             k[turned] = np.einsum("eaij,eaibk,ebkl->eajbl", blocks, k[turned].reshape(len(turned), 9, SLOTS, 9, SLOTS),
                                   blocks, optimize=True).reshape(len(turned), ELEMENT_DOFS, ELEMENT_DOFS)
         tangent = self.pattern.assemble(k)
+        del k
         coupled = self._coupled()
         tangent = tangent if coupled is None else (tangent - coupled).tocsc()
         return tangent if self.inertia is None else self.inertia.tangent(tangent, self._free_masses())

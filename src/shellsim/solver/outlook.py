@@ -34,6 +34,7 @@ from ..loads import ToolForces, stable_step
 from .equilibrium import warmed
 from .simulation import Simulation
 from .sparse_lu import SymmetricPatternLU
+from .tangent_pattern import free_columns
 from .rehearsal import REHEARSAL_ELEMENTS, REHEARSAL_SECONDS, critical_steps_under_load, newton_rehearsal
 from .timestep import MARGIN_SHARE, EstimateSchedule
 
@@ -256,7 +257,7 @@ def static_outlook(model: Model) -> dict:
     def factorised() -> None:
         tangent = equilibrium.tangent()
         with suppress(RuntimeError):  # singular at rest (a slack chord's nodes): the forming's time alone
-            SymmetricPatternLU(tangent[:, :equilibrium.unknowns.n_free])
+            SymmetricPatternLU(free_columns(tangent, equilibrium.unknowns.n_free))
 
     return newton_holds(model) | {"seconds": quickest(factorised),
                                   "residual_seconds": quickest(lambda: equilibrium.evaluate(0.0))}

@@ -13,6 +13,11 @@ the factors by 8-13 (0.04 s to 1-2 s a factorisation).
 
 Measured on the pinched hemisphere's tangent (21,666 unknowns, 1.7 M entries): the
 general way 0.90 s and 20.5 M entries in the factors; on the diagonal 0.20-0.23 s and 5.4 M.
+On a wild iterate of its 10^4-element mesh (203,202 unknowns) the general way took 93 s
+and 513 M entries (4.8 GB) against 5 s and 76 M, and left a residual of 5e-4 all the
+same: such a tangent is no better pivoted. So the general way is taken only where its
+factors fit the memory available and SuperLU's 32-bit indices; otherwise the tangent is
+refused (:class:`FactorsTooLarge`), and a Newton step is cut back as for a singular one.
 """
 
 from __future__ import annotations
@@ -21,22 +26,46 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..memory import available_bytes, size_text
+from .superlu_pivots import pivots
+
 #: A probe solve leaving more than this share of its right-hand side calls for pivoting.
 PROBE_TOLERANCE = 1e-8
+#: The most the general way multiplies the factors' entries on the diagonal by, as the
+#: bound its memory is judged by (measured 3.8x and 6.7x, above).
+PIVOTED_GROWTH = 8
+#: The factors' entries on the diagonal against the matrix's (3.2 and 4.7 measured on the
+#: hemisphere's tangents above).
+DIAGONAL_FILL = 5
+#: Bytes a factor entry takes in SuperLU's storage (measured 9.3-10).
+FACTOR_ENTRY_BYTES = 10
+#: SuperLU's indices are 32-bit: factors with more entries than this overflow them (seen
+#: as "On entry to DGEMV parameter number 2 had an illegal value" and wrong factors).
+INDEX_LIMIT = 2**31 - 1
+
+
+class FactorsTooLarge(RuntimeError):
+    """The factors on the diagonal are unsound and pivoted ones would not fit: why, in words."""
 
 
 class SymmetricPatternLU:
     """LU factors of a square sparse matrix (n, n) whose pattern is symmetric. Raises
-    RuntimeError when the matrix is singular (SuperLU's "Factor is exactly singular")."""
+    RuntimeError when the matrix is singular (SuperLU's "Factor is exactly singular"), and
+    FactorsTooLarge when its factors on the diagonal are unsound and pivoted ones would not
+    fit."""
 
     def __init__(self, matrix: sp.spmatrix):
-        scaled = sp.csc_matrix(matrix, copy=True)
-        diagonal = np.abs(scaled.diagonal())
+        matrix = sp.csc_matrix(matrix)  # no copy of a CSC matrix
+        diagonal = np.abs(matrix.diagonal())
         self._scale = 1.0 / np.sqrt(np.where(diagonal > 0.0, diagonal, 1.0))
-        columns = np.repeat(np.arange(scaled.shape[1]), np.diff(scaled.indptr))
-        scaled.data *= self._scale[scaled.indices] * self._scale[columns]
+        # the scaled values on the matrix's own index arrays (a copy of those is 4 bytes an entry)
+        values = self._scale[matrix.indices]
+        values *= np.repeat(self._scale, np.diff(matrix.indptr))
+        values *= matrix.data
+        scaled = sp.csc_matrix((values, matrix.indices, matrix.indptr), shape=matrix.shape)
         #: whether the factors pivoted off the diagonal (the probe failed)
         self.pivoted = False
+        self._lu = None
         try:
             self._lu = spla.splu(scaled, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                                  options={"SymmetricMode": True})
@@ -45,6 +74,10 @@ class SymmetricPatternLU:
         except RuntimeError:  # a zero pivot on the diagonal
             good = False
         if not good:
+            # bounded by the factors on the diagonal, or where they broke down by their usual fill
+            entries = PIVOTED_GROWTH * (self._lu.nnz if self._lu is not None else DIAGONAL_FILL * scaled.nnz)
+            self._lu = None  # the unsound factors go before the general ones are formed
+            _refuse_if_unfit(entries)
             self.pivoted = True
             self._lu = spla.splu(scaled, permc_spec="COLAMD")
 
@@ -56,13 +89,25 @@ class SymmetricPatternLU:
         the diagonal, which mixes the rows."""
         if self.pivoted or not np.array_equal(self._lu.perm_r, self._lu.perm_c):
             return None
-        return int(np.count_nonzero(self._lu.U.diagonal() < 0.0))
+        return int(np.count_nonzero(pivots(self._lu) < 0.0))
 
     @property
     def entries(self) -> int:
         """The entries stored in the factors, L's and U's (the fill, with the matrix's own)."""
-        return self._lu.L.nnz + self._lu.U.nnz
+        return self._lu.nnz  # SuperLU's count (``L`` and ``U`` would copy both factors)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """x (n,) with matrix @ x = rhs (n,)."""
         return self._scale * self._lu.solve(self._scale * rhs)
+
+
+def _refuse_if_unfit(entries: int) -> None:
+    """Raise FactorsTooLarge when pivoted factors of up to ``entries`` entries would not fit
+    the memory available or SuperLU's indices."""
+    need, have = entries * FACTOR_ENTRY_BYTES, available_bytes()
+    if entries > INDEX_LIMIT:
+        raise FactorsTooLarge(f"its pivots on the diagonal are unsound, and pivoted factors could take up to "
+                              f"{entries:,} entries, more than SuperLU's {INDEX_LIMIT:,}")
+    if have is not None and need > have:
+        raise FactorsTooLarge(f"its pivots on the diagonal are unsound, and pivoted factors could need "
+                              f"{size_text(need)} of memory, where {size_text(have)} is available")

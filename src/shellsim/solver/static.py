@@ -32,8 +32,9 @@ from ..loads import contact_pairs, hold_pairs, pairs_added, passed_through
 from .equilibrium import Converged, Equilibrium
 from .quality import folding_diagnosis
 from .run import Listener, Run, output_times, take_frame, take_sample
-from .sparse_lu import SymmetricPatternLU
+from .sparse_lu import FactorsTooLarge, SymmetricPatternLU
 from .stability import StabilityWatch
+from .tangent_pattern import free_columns
 from .static_work import StaticWork
 
 CUT, GROW, GROWTH_TANGENTS = 0.25, 1.5, 4
@@ -80,11 +81,19 @@ class SingularTangent(NotConverged):
     """A tangent with no factors: formed at a converged state, no shorter step helps."""
 
 
+class UnfactorisableTangent(SingularTangent):
+    """A tangent whose pivots on the diagonal are unsound and whose pivoted factors would
+    not fit (:class:`shellsim.solver.sparse_lu.FactorsTooLarge`)."""
+
+
 #: What to do about a tangent that is singular at a converged state.
 SINGULAR_ADVICE = ("A node held by nothing in some direction (a slack cable's free end or joint, a node on no "
                    "element, a structure free to move as a whole) leaves the tangent singular where nothing is "
                    "stretched yet: hold it, give its cables a prestretch, or solve the scene explicitly "
                    "(solver.method = \"explicit\"), where its mass keeps it in place")
+#: What to do about a tangent at a converged state that cannot be factorised in the memory.
+UNFACTORISABLE_ADVICE = ("A coarser mesh, a machine with more memory, or the explicit method "
+                         "(solver.method = \"explicit\") may get past it")
 
 
 class NewtonSolver:
@@ -108,7 +117,7 @@ class NewtonSolver:
         each free row's diagonal stiffness times the model's extent, over the free rows.
         The internal forces come from positions of that size, so a residual below it is
         noise (it is what a small load step near the start stalls at)."""
-        diagonal = np.abs(tangent[:, :self.n_free].diagonal())
+        diagonal = np.abs(free_columns(tangent, self.n_free).diagonal())
         return float(np.finfo(float).eps * self.extent * np.linalg.norm(diagonal))
 
     def free_residual(self) -> np.ndarray:
@@ -129,7 +138,9 @@ class NewtonSolver:
         start = time.perf_counter()
         tangent = self.eq.tangent()
         try:
-            lu = SymmetricPatternLU(tangent[:, :self.n_free])
+            lu = SymmetricPatternLU(free_columns(tangent, self.n_free))
+        except FactorsTooLarge as error:
+            raise UnfactorisableTangent(f"the tangent cannot be factorised here: {error}") from None
         except RuntimeError as error:  # "Factor is exactly singular"
             raise SingularTangent(f"the tangent stiffness is singular ({error}){self._stiffless(tangent)}") from None
         self.run.tangent_seconds.append(time.perf_counter() - start)
@@ -141,7 +152,7 @@ class NewtonSolver:
         """The nodes a tangent (n_free, size) gives no stiffness in some free direction
         (a zero diagonal), for a message: '; nodes 12, 13 (the first at (0, 1, 2)) have no
         stiffness in some direction'; '' when there are none."""
-        diagonal = np.abs(tangent[:, :self.n_free].diagonal())
+        diagonal = np.abs(free_columns(tangent, self.n_free).diagonal())
         zero = diagonal <= 1e-14 * max(float(diagonal.max(initial=0.0)), 1e-300)
         if not zero.any():
             return ""
@@ -158,7 +169,8 @@ class NewtonSolver:
         try:
             return self.linearised(at_converged=record)
         except SingularTangent as why:
-            raise NumericalError(not_converged(self.run, self, where, str(why), SINGULAR_ADVICE)) from None
+            advice = UNFACTORISABLE_ADVICE if isinstance(why, UnfactorisableTangent) else SINGULAR_ADVICE
+            raise NumericalError(not_converged(self.run, self, where, str(why), advice)) from None
 
     def observe(self) -> None:
         """Record the stability of the converged state: a tangent there, with its own load
@@ -168,6 +180,7 @@ class NewtonSolver:
         if self.eq.inertia is not None:
             return
         self.eq.evaluate(self.run.load_time)
+        self.tangent = None  # its factors go before the new ones are formed
         self.tangent = self.at_converged(f"at load time {self.run.load_time:.6g}, where the converged state's tangent "
                                          "is formed")
 
@@ -254,7 +267,9 @@ class NewtonSolver:
                     (before_state, pending, residual, norm) = before
                     before_state.restore(self.run.sim)
                     eq.evaluate(t)
-                self.tangent, before = self.linearised(), None
+                # the old factors go before the new are formed: together they would double the peak
+                self.tangent = before = None
+                self.tangent = self.linearised()
                 tangents += 1
             # the iterate before the correction, kept only where it may be gone back to
             start = Converged(self.run.sim) if line_search or not fresh else None

@@ -19,19 +19,35 @@ from .unknowns import Unknowns
 
 class TangentPattern(NamedTuple):
     """The CSC structure of the tangent (n_free, size): indices (nnz,), indptr (size + 1,);
-    and for the element blocks k (ne, 45, 45), the flat positions ``entries`` of those that
-    land in it and their places ``slots`` (both (m,)) among its nnz stored values."""
+    and for the element blocks k (ne, 45, 45), each entry's place ``slots`` (ne * 2025,)
+    among its nnz stored values, or nnz for an entry that lands in no stored value (a
+    fixed row or column, or a prescribed row)."""
 
     indices: np.ndarray
     indptr: np.ndarray
-    entries: np.ndarray
     slots: np.ndarray
     shape: tuple[int, int]
 
     def assemble(self, k: np.ndarray) -> sp.csc_matrix:
-        """The sum of the element blocks k (ne, 45, 45) in the nodes' frames as a matrix."""
-        data = np.bincount(self.slots, weights=k.ravel()[self.entries], minlength=len(self.indices))
+        """The sum of the element blocks k (ne, 45, 45) in the nodes' frames as a matrix;
+        the entries that land nowhere are summed into one value past the last and left."""
+        nnz = len(self.indices)
+        data = np.bincount(self.slots, weights=k.reshape(-1), minlength=nnz + 1)[:nnz]
         return sp.csc_matrix((data, self.indices, self.indptr), shape=self.shape)
+
+
+def free_columns(tangent: sp.csc_matrix, n_free: int) -> sp.csc_matrix:
+    """The free columns (n_free, n_free) of a tangent (n_free, size) in CSC, the free
+    columns first: a matrix on the tangent's own arrays (a slice would copy them)."""
+    end = tangent.indptr[n_free]
+    return sp.csc_matrix((tangent.data[:end], tangent.indices[:end], tangent.indptr[:n_free + 1]),
+                         shape=(n_free, n_free))
+
+
+#: Elements whose entries are placed at once: the (ne, 9, 5, 9, 5) places of all of them
+#: would be worked out in 8-byte integers, three arrays of them at a time (at 10^4 elements
+#: 0.9 GB held up, more than the tangent itself).
+ELEMENT_CHUNK = 2048
 
 
 def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
@@ -55,16 +71,21 @@ def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
     lengths = column_length[node_of_column]
     indptr = np.zeros(u.size + 1, dtype=np.int64)
     np.cumsum(lengths, out=indptr[1:])
+    nnz = int(indptr[-1])
     all_rows = np.repeat(first_row[row_node] - pair_start, pair_rows) + np.arange(pair_rows.sum())
-    within = np.arange(indptr[-1]) - np.repeat(indptr[:-1], lengths)
+    within = np.arange(nnz) - np.repeat(indptr[:-1], lengths)
     indices = all_rows[np.repeat(pair_start[first_pair[node_of_column]], lengths) + within]
+    index_type = np.int32 if nnz < np.iinfo(np.int32).max else np.int64
     # each element entry (e, row node, its slot, column node, its slot): its column's start,
     # its row node's offset there, its row's rank among that node's
-    index = u.index[conn]  # (ne, 9, 5)
-    column_start = indptr[np.maximum(index, 0)]
-    rank = index - first_row[conn][:, :, None]
-    slots = column_start[:, None, None] + offset[pair_of][:, :, None, :, None] + rank[:, :, :, None, None]
-    used = ((index >= 0) & (index < u.n_free))[:, :, :, None, None] & known[conn][:, None, None]
-    entries = np.flatnonzero(used)
-    return TangentPattern(indices.astype(np.int32), indptr.astype(np.int32), entries, slots.ravel()[entries],
+    slots = np.empty((len(conn), 9, 5, 9, 5), dtype=index_type)
+    for first in range(0, len(conn), ELEMENT_CHUNK):
+        chunk = slice(first, first + ELEMENT_CHUNK)
+        index = u.index[conn[chunk]]  # (m, 9, 5)
+        column_start = indptr[np.maximum(index, 0)]
+        rank = index - first_row[conn[chunk]][:, :, None]
+        places = column_start[:, None, None] + offset[pair_of[chunk]][:, :, None, :, None] + rank[:, :, :, None, None]
+        used = ((index >= 0) & (index < u.n_free))[:, :, :, None, None] & known[conn[chunk]][:, None, None]
+        slots[chunk] = np.where(used, places, nnz)
+    return TangentPattern(indices.astype(index_type), indptr.astype(index_type), slots.reshape(-1),
                           (u.n_free, u.size))

@@ -8,11 +8,12 @@ what it formed before), its LU factors on the diagonal (the solver's,
 :mod:`shellsim.solver.sparse_lu`) and by SuperLU's default (COLAMD, pivoting freely; the
 solver's before; in a process of its own, so that the peak memory shown is the solver's),
 the entries in the factors, and one solve. Medians of ``--repeat`` runs. With
-``--runs``, whole nonlinear runs of the deck with its forces times 10^5 (a radial
-displacement of about 3.4 at A, 85 thicknesses) for the wall time and peak memory per mesh.
+``--runs``, whole runs of the deck with its forces times ``--scale`` (10^5 by default: a
+radial displacement of about 3.4 at A, 85 thicknesses) for the wall time and peak memory
+per mesh, stability checks and all.
 Prints Markdown tables; nothing is asserted.
 
-    .venv/bin/python benchmarks/static_scaling.py [--patches 8 16 23 32 50] [--runs 6 11 23] [--no-colamd]
+    .venv/bin/python benchmarks/static_scaling.py [--patches 8 16 23 32 50] [--runs 6 11 23] [--scale 1e5] [--no-colamd]
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DECK = ROOT / "decks" / "verification" / "pinched_hemisphere_static.toml"
-#: The deck's forces scaled up for the nonlinear runs.
+#: The deck's forces scaled up for the nonlinear runs (``--scale``'s default).
 NONLINEAR = 1e5
 
 #: One mesh's operations, in a child process; prints a JSON row.
@@ -104,11 +105,11 @@ def operations(patches: list[int], repeat: int, colamd: bool) -> None:
               f"| {r['peak_bytes'] / r['elements'] / 1e3:.0f} |", flush=True)
 
 
-def runs(patches: list[int]) -> None:
+def runs(patches: list[int], scale: float) -> None:
     print("| elements | DOFs | load steps | iterations | tangents | wall time of the solve [s] | peak memory [MB] "
           "| per element [kB] | u_A |")
     print("|---|---|---|---|---|---|---|---|---|")
-    text = DECK.read_text().replace("1.0e-3", repr(1.0e-3 * NONLINEAR))
+    text = DECK.read_text().replace("1.0e-3", repr(1.0e-3 * scale))
     text = text[:text.index("[[reference]]")]  # the deck's reference is for its linear forces
     for patch in patches:
         with tempfile.TemporaryDirectory() as folder:
@@ -137,6 +138,8 @@ def main() -> None:
     parser.add_argument("--runs", type=int, nargs="*", default=[6, 11, 23],
                         help="patches of the whole nonlinear runs (6, 11, 23: about 8 x 8, 16 x 16, 32 x 32 "
                              "elements on the quarter)")
+    parser.add_argument("--scale", type=float, default=NONLINEAR,
+                        help="the deck's forces times this in the whole runs (1: its own, nearly linear, forces)")
     parser.add_argument("--repeat", type=int, default=3, help="runs of each operation (the median is shown)")
     parser.add_argument("--no-colamd", action="store_true",
                         help="leave out SuperLU's COLAMD (its time grew as n^2.1 to 19.5 s at 5,000 elements)")
@@ -145,7 +148,7 @@ def main() -> None:
         operations(args.patches, args.repeat, not args.no_colamd)
     if args.runs:
         print()
-        runs(args.runs)
+        runs(args.runs, args.scale)
 
 
 if __name__ == "__main__":

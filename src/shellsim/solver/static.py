@@ -276,9 +276,10 @@ class NewtonSolver:
             if not fresh:
                 before = (start, pending, residual, norm)
             previous = norm
-            tangent, lu, _ = self.tangent
-            rhs = residual - tangent[:, n_free:] @ pending if np.any(pending) else residual
-            correction = lu.solve(rhs)
+            # read through self.tangent, not held in names of this loop: those would keep the
+            # factors alive past the next tangent's
+            rhs = residual - self.tangent[0][:, n_free:] @ pending if np.any(pending) else residual
+            correction = self.tangent[1].solve(rhs)
             if first_energy is None:
                 first_energy = max(abs(float(correction @ rhs)), 1e-300)
             eq.move(np.concatenate([correction, pending]))

@@ -98,6 +98,27 @@ def test_a_rehearsal_out_of_time_keeps_the_start():
     assert list(times) == [0.0] and len(critical) == 1  # the start
 
 
+def test_a_state_whose_step_cannot_be_estimated_ends_the_rehearsal_before_it(monkeypatch):
+    """The stretched sheet with the step's estimate failing at its second state, as at a
+    state whose forces overflow (scipy: 'array must not contain infs or NaNs'): the
+    rehearsal keeps the start alone, a time for each step (a time without its step had
+    stopped check with 'fp and xp are not of the same length')."""
+    monkeypatch.setattr(rehearsal, "REHEARSAL_SECONDS", math.inf)
+    estimates = iter([False, True])
+
+    def failing(*args):
+        if next(estimates, True):
+            raise ValueError("array must not contain infs or NaNs")
+        return real(*args)
+
+    real = rehearsal.stable_step
+    monkeypatch.setattr(rehearsal, "stable_step", failing)
+    deck = parse_deck(STRETCHED)
+    run = prepared(deck)
+    times, critical = critical_steps_under_load(deck, run.mesh, run.model)
+    assert list(times) == [0.0] and len(critical) == 1
+
+
 ROLLUP_STATIC = ROOT / "decks" / "verification" / "test04_strip_rollup_static.toml"
 
 

@@ -117,6 +117,23 @@ def test_a_mesh_file_larger_than_the_memory_is_refused_once_read(tmp_path, monke
         " ".join(result.output.split())
 
 
+def test_a_static_scene_is_reckoned_with_its_tangents_factors(tmp_path, monkeypatch):
+    """The pinched hemisphere (128 elements) with 410 MB available: solved explicitly it
+    would hold about 403 MB and is checked; statically, with its tangent and factors (165 kB
+    an element), about 421 MB, and it is refused once meshed."""
+    from shellsim import memory
+
+    monkeypatch.setattr(memory, "available_bytes", lambda: 4.1e8)
+    static = ROOT / "decks" / "verification" / "pinched_hemisphere_static.toml"
+    refused = runner.invoke(app, ["check", str(static)])
+    assert refused.exit_code == 2
+    assert "the mesh has 128 elements: a run needs about 421 MB of memory and 410 MB is available" in \
+        " ".join(refused.output.split())
+    explicit = tmp_path / "hemisphere.toml"
+    explicit.write_text(static.read_text().replace('method = "static"', 'method = "explicit"'))
+    assert "a run needs about" not in " ".join(runner.invoke(app, ["check", str(explicit)]).output.split())
+
+
 def test_check_gives_the_step_and_suggests_m1_for_a_thin_shell_on_m2(tmp_path):
     thin = ROOT / "decks" / "stability" / "thin_plate_1e-3.toml"
     shipped = runner.invoke(app, ["check", str(thin)])  # M1: no hint

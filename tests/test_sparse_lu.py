@@ -84,3 +84,17 @@ def test_unsound_pivots_whose_pivoted_factors_would_not_fit_are_refused(monkeypa
     pair = sp.csc_matrix([[1e-10, 1.0], [1.0, 1e-10]])
     with pytest.raises(sparse_lu.FactorsTooLarge, match="pivoted factors could need .* where 1 kB is available"):
         SymmetricPatternLU(sp.csc_matrix(sp.block_diag([laplacian(6)] + [pair] * 10)))
+
+
+def test_a_matrix_too_large_for_superlus_first_guess_is_factorised_by_its_ilu_dropping_nothing(monkeypatch):
+    """Where 20 times the entries would overflow SuperLU's 32-bit first guess (here made so
+    by a first guess of 10^9), the incomplete LU dropping nothing stands in: the same
+    solution to round-off, the same pivots' signs, and (with no memory) the same refusal."""
+    a = indefinite(20, 3.3)
+    x = np.random.default_rng(4).standard_normal(a.shape[0])
+    complete = SymmetricPatternLU(a)
+    monkeypatch.setattr(sparse_lu, "FIRST_GUESS", 10**9)
+    large = SymmetricPatternLU(a)
+    assert not large.pivoted and large.entries <= 1.05 * complete.entries  # (7,533 and 7,344)
+    assert np.linalg.norm(large.solve(a @ x) - x) <= 1e-10 * np.linalg.norm(x)
+    assert large.negative_pivots == complete.negative_pivots > 0

@@ -27,9 +27,10 @@ def sized_mesh(scene: Deck, deck_folder: Path, announce: Callable[[str], None] =
 
     announce("meshing")
     mesh = build_mesh(scene, deck_folder)
+    newton = scene.solver.newton
     announce(f"{mesh.n_elements:,} elements, {mesh.n_nodes:,} nodes, {5 * mesh.n_nodes:,} DOFs: "
-             f"about {size_text(memory_bytes(mesh.n_elements))} of memory")
-    refuse_if_too_big(mesh.n_elements)
+             f"about {size_text(memory_bytes(mesh.n_elements, newton))} of memory")
+    refuse_if_too_big(mesh.n_elements, newton=newton)
     return mesh
 
 

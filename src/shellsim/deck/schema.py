@@ -357,6 +357,12 @@ class Solver(Section):
     relaxation: Relaxation | None = None
     imaged: Imaged | None = None
 
+    @property
+    def newton(self) -> bool:
+        """Whether a run takes Newton steps, and so holds a tangent's factors: static,
+        implicit, a preload, or the unloaded shape of an imaged mesh found first."""
+        return self.method != "explicit" or self.preload is not None or self.imaged is not None
+
     @model_validator(mode="after")
     def _explicit_only(self) -> "Solver":
         if self.method != "explicit":

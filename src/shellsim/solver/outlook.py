@@ -219,7 +219,7 @@ def step_outlook(deck: Deck, mesh: Mesh, model: Model, on_product: Callable[[int
                + schedule["samples"] * (costs["sample"] + costs["call"]))
     return critical | {"dt": dt, "mass_factor": mass_factor, "steps": schedule["steps"], "until": until,
                        "seconds": seconds, "loaded": loaded, "contact_share": contact / costs["step"],
-                       "bytes": memory_bytes(model.n_elements)}
+                       "bytes": memory_bytes(model.n_elements, deck.solver.newton)}
 
 
 def _critical_under_load(deck: Deck, mesh: Mesh, model: Model, at_rest: float,
@@ -242,7 +242,7 @@ def _critical_under_load(deck: Deck, mesh: Mesh, model: Model, at_rest: float,
 def newton_holds(model: Model) -> dict:
     """What a static or implicit solve of ``model`` holds: ``unknowns`` (5 DOF per node,
     supports' included) and ``bytes``."""
-    return {"unknowns": 5 * model.n_nodes, "bytes": memory_bytes(model.n_elements)}
+    return {"unknowns": 5 * model.n_nodes, "bytes": memory_bytes(model.n_elements, newton=True)}
 
 
 def static_outlook(model: Model) -> dict:

@@ -48,6 +48,8 @@ def free_columns(tangent: sp.csc_matrix, n_free: int) -> sp.csc_matrix:
 #: would be worked out in 8-byte integers, three arrays of them at a time (at 10^4 elements
 #: 0.9 GB held up, more than the tangent itself).
 ELEMENT_CHUNK = 2048
+#: The sparse tangent's entries whose rows are worked out at once.
+ENTRY_CHUNK = 1 << 22
 
 
 def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
@@ -72,10 +74,17 @@ def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
     indptr = np.zeros(u.size + 1, dtype=np.int64)
     np.cumsum(lengths, out=indptr[1:])
     nnz = int(indptr[-1])
-    all_rows = np.repeat(first_row[row_node] - pair_start, pair_rows) + np.arange(pair_rows.sum())
-    within = np.arange(nnz) - np.repeat(indptr[:-1], lengths)
-    indices = all_rows[np.repeat(pair_start[first_pair[node_of_column]], lengths) + within]
     index_type = np.int32 if nnz < np.iinfo(np.int32).max else np.int64
+    # every column of a node holds that node's rows: all_rows, by column node
+    all_rows = np.repeat(first_row[row_node] - pair_start, pair_rows) + np.arange(pair_rows.sum())
+    rows_less_start = pair_start[first_pair[node_of_column]] - indptr[:-1]  # a column's rows in all_rows
+    indices = np.empty(nnz, dtype=index_type)
+    # a run of columns at a time, as the element entries: nnz-long temporaries were 5 GB at 10^5 elements
+    bounds = np.unique(np.append(np.searchsorted(indptr, np.arange(0, nnz, ENTRY_CHUNK), side="right") - 1, u.size))
+    for first, stop in zip(bounds[:-1], bounds[1:]):
+        start, end = indptr[first], indptr[stop]
+        indices[start:end] = all_rows[np.repeat(rows_less_start[first:stop], lengths[first:stop])
+                                      + np.arange(start, end)]
     # each element entry (e, row node, its slot, column node, its slot): its column's start,
     # its row node's offset there, its row's rank among that node's
     slots = np.empty((len(conn), 9, 5, 9, 5), dtype=index_type)
@@ -87,5 +96,5 @@ def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
         places = column_start[:, None, None] + offset[pair_of[chunk]][:, :, None, :, None] + rank[:, :, :, None, None]
         used = ((index >= 0) & (index < u.n_free))[:, :, :, None, None] & known[conn[chunk]][:, None, None]
         slots[chunk] = np.where(used, places, nnz)
-    return TangentPattern(indices.astype(index_type), indptr.astype(index_type), slots.reshape(-1),
+    return TangentPattern(indices, indptr.astype(index_type), slots.reshape(-1),
                           (u.n_free, u.size))

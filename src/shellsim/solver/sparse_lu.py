@@ -57,14 +57,14 @@ LARGE_FIRST_GUESS = 10
 
 
 class FactorsTooLarge(RuntimeError):
-    """The factors on the diagonal are unsound and pivoted ones would not fit: why, in words."""
+    """Factors that do not fit: pivoted ones where those on the diagonal are unsound, or
+    those on the diagonal themselves (SuperLU out of memory); why, in words."""
 
 
 class SymmetricPatternLU:
     """LU factors of a square sparse matrix (n, n) whose pattern is symmetric. Raises
     RuntimeError when the matrix is singular (SuperLU's "Factor is exactly singular"), and
-    FactorsTooLarge when its factors on the diagonal are unsound and pivoted ones would not
-    fit."""
+    FactorsTooLarge when the factors it needs do not fit."""
 
     def __init__(self, matrix: sp.spmatrix):
         matrix = sp.csc_matrix(matrix)  # no copy of a CSC matrix

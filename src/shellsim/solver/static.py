@@ -82,8 +82,7 @@ class SingularTangent(NotConverged):
 
 
 class UnfactorisableTangent(SingularTangent):
-    """A tangent whose pivots on the diagonal are unsound and whose pivoted factors would
-    not fit (:class:`shellsim.solver.sparse_lu.FactorsTooLarge`)."""
+    """A tangent whose factors do not fit the memory (:class:`shellsim.solver.sparse_lu.FactorsTooLarge`)."""
 
 
 #: What to do about a tangent that is singular at a converged state.
@@ -117,8 +116,11 @@ class NewtonSolver:
         each free row's diagonal stiffness times the model's extent, over the free rows.
         The internal forces come from positions of that size, so a residual below it is
         noise (it is what a small load step near the start stalls at)."""
-        diagonal = np.abs(free_columns(tangent, self.n_free).diagonal())
-        return float(np.finfo(float).eps * self.extent * np.linalg.norm(diagonal))
+        return float(np.finfo(float).eps * self.extent * np.linalg.norm(self._free_diagonal(tangent)))
+
+    def _free_diagonal(self, tangent) -> np.ndarray:
+        """|K_ii| (n_free,) of a tangent (n_free, size): the free unknowns' own stiffnesses."""
+        return np.abs(free_columns(tangent, self.n_free).diagonal())
 
     def free_residual(self) -> np.ndarray:
         """The residual over the free unknowns (n_free,) of the last evaluation, kept for a
@@ -152,7 +154,7 @@ class NewtonSolver:
         """The nodes a tangent (n_free, size) gives no stiffness in some free direction
         (a zero diagonal), for a message: '; nodes 12, 13 (the first at (0, 1, 2)) have no
         stiffness in some direction'; '' when there are none."""
-        diagonal = np.abs(free_columns(tangent, self.n_free).diagonal())
+        diagonal = self._free_diagonal(tangent)
         zero = diagonal <= 1e-14 * max(float(diagonal.max(initial=0.0)), 1e-300)
         if not zero.any():
             return ""

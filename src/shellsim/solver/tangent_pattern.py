@@ -79,8 +79,10 @@ def tangent_pattern(conn: np.ndarray, u: Unknowns) -> TangentPattern:
     all_rows = np.repeat(first_row[row_node] - pair_start, pair_rows) + np.arange(pair_rows.sum())
     rows_less_start = pair_start[first_pair[node_of_column]] - indptr[:-1]  # a column's rows in all_rows
     indices = np.empty(nnz, dtype=index_type)
-    # a run of columns at a time, as the element entries: nnz-long temporaries were 5 GB at 10^5 elements
-    bounds = np.unique(np.append(np.searchsorted(indptr, np.arange(0, nnz, ENTRY_CHUNK), side="right") - 1, u.size))
+    # a run of columns of about ENTRY_CHUNK entries at a time: nnz-long temporaries were 5 GB
+    # at 10^5 elements
+    starts = np.searchsorted(indptr, np.arange(0, nnz, ENTRY_CHUNK), side="right") - 1  # each run's first column
+    bounds = np.unique(np.append(starts, u.size))
     for first, stop in zip(bounds[:-1], bounds[1:]):
         start, end = indptr[first], indptr[stop]
         indices[start:end] = all_rows[np.repeat(rows_less_start[first:stop], lengths[first:stop])

@@ -20,7 +20,8 @@ from numba.core import caching
 from shellsim.array_copy import copy_into
 from shellsim.cache_lock import LOCK_FILE, lock_cache_saves
 from shellsim.compile_beside import CompiledBeside
-from shellsim.element.response import group_arrays, response_signature
+from shellsim.element.response import response_signature
+from shellsim.element.work_arrays import group_arrays
 from shellsim.element.steps import steps_of
 from shellsim.solver import simulation
 from shellsim.solver.simulation import Simulation
@@ -64,7 +65,8 @@ import numpy as np
 from numba import njit, types
 from shellsim.array_copy import copy_into
 from shellsim.compile_beside import CompiledBeside
-from shellsim.element.response import group_arrays, response_signature
+from shellsim.element.response import response_signature
+from shellsim.element.work_arrays import group_arrays
 from shellsim.element.steps import steps_of
 
 @njit

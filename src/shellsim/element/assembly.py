@@ -18,7 +18,7 @@ from numba import get_num_threads, njit, prange
 from .frames import director_increments, to_rotational
 from .groups import (gather_element_values, gather_members_shape, gather_nodal_vectors, group_count,
                      part_group_members, scatter_element_values)
-from .response import group_arrays
+from .work_arrays import group_arrays
 from .steps import steps_of
 from ..compiled_call import TypedCall
 

@@ -1,7 +1,7 @@
 """Assumed membrane and transverse shear strains of an element group, and their adjoints
 (the effective stresses they put at the tying points); the in-plane volumetric projection
 of plane strain. Arrays carry the group's lanes last (G); ``points`` and ``scratch`` are
-the group's :class:`shellsim.element.response.Points` and ``Scratch``.
+the group's :class:`shellsim.element.work_arrays.Points` and ``Scratch``.
 
 Assumed membrane strain against membrane locking (a curved quadratic element cannot bend
 without stretching by O(theta^2), which full integration samples): the covariant
@@ -55,7 +55,7 @@ def _solve2(a00, a01, a10, a11, b0, b1, out0, out1):
         out1[lane] = (a00[lane] * b1[lane] - a10[lane] * b0[lane]) / det
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def tie_membrane(rule, points, scratch, nq, nt):
     """Replace the membrane part of the lamina strains points.EPS at the Gauss points by
     its tied interpolation (the through-thickness means weighted by rule.share)."""
@@ -98,7 +98,7 @@ def tie_membrane(rule, points, scratch, nq, nt):
                 EPS[p, k, 2, lane] += 2.0 * local[0, 1, lane]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def tie_shear(rule, points, scratch, nq, nt):
     """Replace the transverse shears of points.EPS at the Gauss points by their tied
     interpolation: the covariant shears gamma_a = g_a . gamma (gamma = (2e13, 2e23) in
@@ -129,7 +129,7 @@ def tie_shear(rule, points, scratch, nq, nt):
             _solve2(lam[0, 0], lam[0, 1], lam[1, 0], lam[1, 1], delta[0], delta[1], EPS[p, k, 3], EPS[p, k, 4])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def membrane_tying_stresses(rule, points, scratch, nq, nt):
     """The adjoint of :func:`tie_membrane`: the volume-weighted in-plane stresses points.SW
     contracted with the contravariant basis, Bab(p) = sum_k dv g^a . sigma_m . g^b (twice
@@ -166,7 +166,7 @@ def membrane_tying_stresses(rule, points, scratch, nq, nt):
                         T[tie_points[c, m], c, lane] += tie[c, p, m] * Bab[p, c, lane]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def shear_tying_stresses(rule, points, stress, scratch, nq, nt):
     """The adjoint of :func:`tie_shear`: the shear stresses (in ``stress`` (nq, nt, 5, G))
     work through the tied covariant shears only; tau . A_p^-1 g* at the Gauss points puts

@@ -1,7 +1,8 @@
 """Stresses and nodal forces of an element group, in visible phases: geometry and strain
 at every point, the assumed strains, the stress update, the tying adjoints, the forces.
-The phases hand on what they compute in :class:`Points`; the group's data and results
-are its :class:`Group`; :class:`Scratch` holds one point's temporaries.
+The phases hand on what they compute in the group's work arrays
+(:mod:`shellsim.element.work_arrays`), viewed once at the start with their trailing
+lengths known to the compiled code, so that the lane loops vectorise.
 
 Integration: nq in-plane Gauss points (3 x 3) times nt points through the thickness; the
 membrane tying points (rows nq.. of the rule) get geometry, strains and effective
@@ -9,8 +10,6 @@ stresses too. Work arrays carry the group's lanes last (G, :data:`shellsim.lanes
 """
 
 from __future__ import annotations
-
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit, typeof, types
@@ -23,115 +22,8 @@ from ..array_copy import copy_into
 from ..compiled_call import held_by_address
 from ..lanes import LANES
 from .steps import steps_of
+from .work_arrays import fixed_lanes, group_arrays
 from .stress_update import constant_tensor, convected_layer, hyperelastic_layers
-
-
-class Group(NamedTuple):
-    """An element group as gathered and its results (G = LANES lanes, nq Gauss points, nt
-    layers, npts points): members (G,) element numbers; part (1,) the part (material)
-    they all belong to; xe, de, ue, ve (9, 3, G)
-    positions, directors and the field's increments; he (9, G) fibre lengths; jac0
-    (npts, nt, 3, 3, G) inverse initial Jacobians; axes0 (nq, nt, 3, 3, G) initial
-    material frames (Technique 1); state_stress (nq, nt, 5, G) the state's lamina stresses
-    (the product's initial stress). Results: stress (nq, nt, 5, G) lamina stresses (read
-    first when incremental); stretch (nq, G) normal stretches; fe, ge (9, 3, G) nodal forces."""
-
-    members: np.ndarray
-    part: np.ndarray
-    xe: np.ndarray
-    de: np.ndarray
-    ue: np.ndarray
-    ve: np.ndarray
-    he: np.ndarray
-    jac0: np.ndarray
-    axes0: np.ndarray
-    state_stress: np.ndarray
-    stress: np.ndarray
-    stretch: np.ndarray
-    fe: np.ndarray
-    ge: np.ndarray
-
-
-class Points(NamedTuple):
-    """What the phases hand on, at every point and layer (npts, nt, ...): Q, jinv_all
-    (3, 3, G) lamina frames and inverse Jacobians, G (2, 3, G) tangents g_r, g_s, A
-    (2, 2, G) their lamina components, DV (G) volumes, EPS (5, G) lamina strains,
-    cov_shear and TS (2, G) covariant shears and their tying-point stresses; cbar, T
-    (npts, 3, G) membrane means and tying weights. At the Gauss points (nq, nt, ...): SW
-    (3, G) volume-weighted in-plane stresses, FP, LP (3, 3, G) deformation and field
-    gradients, EPS0 (5, G) strains before the tying; Bab (nq, 3, G)."""
-
-    Q: np.ndarray
-    jinv_all: np.ndarray
-    G: np.ndarray
-    A: np.ndarray
-    DV: np.ndarray
-    EPS: np.ndarray
-    cov_shear: np.ndarray
-    TS: np.ndarray
-    cbar: np.ndarray
-    T: np.ndarray
-    SW: np.ndarray
-    FP: np.ndarray
-    LP: np.ndarray
-    EPS0: np.ndarray
-    Bab: np.ndarray
-
-
-class Scratch(NamedTuple):
-    """Temporaries of one point, meaningless between phases: jac, F, eg, v, plane, glob,
-    local, sg (3, 3, G); gN, gM (9, 3, G); s5 (5, G); cov, delta (3, G); det (G,); ones
-    (G,) of 1.0; the stress update's M (11, 3, 3, G), Emean (3, 3, G), pressure, volume,
-    normal (G,); the projection's Mb (nb, nb), rhs (nb,)."""
-
-    jac: np.ndarray
-    F: np.ndarray
-    eg: np.ndarray
-    v: np.ndarray
-    plane: np.ndarray
-    glob: np.ndarray
-    local: np.ndarray
-    sg: np.ndarray
-    gN: np.ndarray
-    gM: np.ndarray
-    s5: np.ndarray
-    cov: np.ndarray
-    delta: np.ndarray
-    det: np.ndarray
-    ones: np.ndarray
-    M: np.ndarray
-    Emean: np.ndarray
-    pressure: np.ndarray
-    volume: np.ndarray
-    normal: np.ndarray
-    Mb: np.ndarray
-    rhs: np.ndarray
-
-
-@njit(cache=True, error_model="numpy")
-def group_arrays(npts, nt, nq, nb):
-    """(:class:`Group`, :class:`Points`, :class:`Scratch`) for npts points, nt layers, nq
-    Gauss points and nb volumetric fields."""
-    g = LANES
-    group = Group(
-        members=np.zeros(g, dtype=np.int64), part=np.zeros(1, dtype=np.int64), xe=np.empty((9, 3, g)),
-        de=np.empty((9, 3, g)), ue=np.zeros((9, 3, g)),
-        ve=np.zeros((9, 3, g)), he=np.empty((9, g)), jac0=np.empty((npts, nt, 3, 3, g)),
-        axes0=np.empty((nq, nt, 3, 3, g)), state_stress=np.zeros((nq, nt, 5, g)), stress=np.zeros((nq, nt, 5, g)),
-        stretch=np.ones((nq, g)), fe=np.empty((9, 3, g)), ge=np.empty((9, 3, g)))
-    points = Points(
-        Q=np.empty((npts, nt, 3, 3, g)), jinv_all=np.empty((npts, nt, 3, 3, g)), G=np.empty((npts, nt, 2, 3, g)),
-        A=np.empty((npts, nt, 2, 2, g)), DV=np.empty((npts, nt, g)), EPS=np.empty((npts, nt, 5, g)),
-        cov_shear=np.empty((npts, nt, 2, g)), TS=np.empty((npts, nt, 2, g)), cbar=np.empty((npts, 3, g)),
-        T=np.empty((npts, 3, g)), SW=np.empty((nq, nt, 3, g)), FP=np.empty((nq, nt, 3, 3, g)),
-        LP=np.empty((nq, nt, 3, 3, g)), EPS0=np.empty((nq, nt, 5, g)), Bab=np.empty((nq, 3, g)))
-    scratch = Scratch(
-        jac=np.empty((3, 3, g)), F=np.empty((3, 3, g)), eg=np.empty((3, 3, g)), v=np.empty((3, 3, g)),
-        plane=np.zeros((3, 3, g)), glob=np.empty((3, 3, g)), local=np.empty((3, 3, g)), sg=np.empty((3, 3, g)),
-        gN=np.empty((9, 3, g)), gM=np.empty((9, 3, g)), s5=np.empty((5, g)), cov=np.empty((3, g)), delta=np.empty((3, g)),
-        det=np.empty(g), ones=np.ones(g), M=np.empty((11, 3, 3, g)), Emean=np.empty((3, 3, g)), pressure=np.empty(g),
-        volume=np.empty(g), normal=np.empty(g), Mb=np.empty((nb, nb)), rhs=np.empty(nb))
-    return group, points, scratch
 
 
 @njit(cache=True, error_model="numpy")
@@ -157,6 +49,7 @@ def group_response(steps, rule, material, group, points, scratch, count):
     alone. ``rule``: :class:`shellsim.bundles.Rule`.
     """
     nq, nt = rule.wq.shape[0], rule.tz.shape[0]
+    group, points, scratch = fixed_lanes(group, points, scratch)
     # 1. geometry and strain at every point
     _strains(steps, rule, group, points, scratch)
     # 2. assumed strains
@@ -285,7 +178,7 @@ def _initial_stress_forces(rule, group, points, scratch, nq):
             add_forces(scratch.eg, scratch.gN, scratch.gM, points.DV[p, k], group.fe, group.ge)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _point_forces(rule, group, points, scratch, nq):
     """group.fe, group.ge (9, 3, G) = the virtual work of the stresses at every point: the
     direct in-plane stresses points.SW at the Gauss points, the tied shears points.TS and

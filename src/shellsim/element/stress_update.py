@@ -5,7 +5,9 @@ hyperelastic law under zero normal stress (Technique 1,
 Techniques 2 and 3's accumulated stresses.
 
 Arrays with a trailing G carry the group's lanes; ``group``, ``points`` and ``scratch``
-are the group's arrays (:mod:`shellsim.element.response`).
+are the group's arrays (:mod:`shellsim.element.work_arrays`), viewed again with their
+trailing lengths fixed (:func:`~shellsim.element.work_arrays.fixed_lanes`) by the
+functions the response calls, so that their lane loops vectorise.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from numba import njit
 from ..materials import zero_normal_stress
 from ..tensor3 import congruence, det3, to_global, to_lamina
 from ..lanes import LANES
+from .work_arrays import fixed_lanes
 
 @njit(cache=True, error_model="numpy")
 def constant_tensor(C, eps, stress, incremental):
@@ -51,6 +54,7 @@ def hyperelastic_layers(product, material, group, points, scratch, p, share):
     virtual work then takes (Fl S~ Fl^T, the Kirchhoff stress, does not depend on Fl's
     normal column while S~_33 = 0, up to transverse shear). The tangent is pushed
     forward the same way (Eq 3.26), for the field's lamina strain pulled back."""
+    group, points, scratch = fixed_lanes(group, points, scratch)
     M = scratch.M
     Fl, D, E, S, Cinv, dE, dS, tmp = M[0], M[1], M[2], M[3], M[4], M[5], M[6], M[7]
     law_work, det, pressure, volume, Emean = M[8:], scratch.det, scratch.pressure, scratch.volume, scratch.Emean
@@ -96,6 +100,7 @@ def convected_layer(material, group, points, scratch, p, k, share):
     layer's share, to group.stretch (nq, G)), Technique 2's push-forward by the step's
     stretch (material.push_forward), and the turn by the material's spin relative to the
     lamina frame."""
+    group, points, scratch = fixed_lanes(group, points, scratch)
     normal, s5, M = scratch.normal, group.stress[p, k], scratch.M
     for lane in range(LANES):
         normal[lane] = -material.normal_ratio[group.part[0]] * (points.EPS[p, k, 0, lane] + points.EPS[p, k, 1, lane])

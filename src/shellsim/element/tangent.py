@@ -26,7 +26,7 @@ from .frames import cross, rotate_director
 from ..array_copy import copy_into
 from ..lanes import LANES
 from .groups import gather_element_values, gather_nodal_scalars
-from .response import group_arrays
+from .work_arrays import group_arrays
 from .steps import steps_of
 
 #: DOFs of an element: 9 nodes x (3 translations, 2 rotations).

@@ -25,6 +25,11 @@ The law's own S^w and CC^w : dE are the functions ``material`` holds for each pa
 the model (the kernels' :class:`shellsim.bundles.Material`: energy_stress,
 energy_tangent, params, incompressible, by part); ``part`` picks the group's. Scratch
 ``work`` (3, 3, 3, G).
+
+The functions are inlined into their caller, the stress update
+(:func:`shellsim.element.stress_update.hyperelastic_layers`), whose work arrays have their
+trailing lengths fixed in the compiled code, so that their lane loops vectorise
+(:mod:`shellsim.fixed_shape`).
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from ..lanes import LANES
 from ..tensor3 import det3, to_lamina
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def normal_strain(material, part, E, stretch, work):
     """Set E[2, 2] (3, 3, G) for zero normal stress; stretch (G,) = sqrt(1 + 2 E33), the
     normal stretch."""
@@ -55,7 +60,7 @@ def normal_strain(material, part, E, stretch, work):
         stretch[lane] = np.sqrt(1.0 + 2.0 * E[2, 2, lane])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def solve_normal_strain(E, stretch):
     """Set E[2, 2] so that det(2E + I) = 1 (thesis Eq 3.28), E (3, 3, G).
     det C = C33 (C11 C22 - C12^2) + (terms free of C33), so the solution is direct.
@@ -69,7 +74,7 @@ def solve_normal_strain(E, stretch):
         stretch[lane] = np.sqrt(c33)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def stress(material, part, E, S, Cinv, pressure, volume, work):
     """Second Piola stress S~ (3, 3, G) under zero normal stress (S33 = 0).
 
@@ -103,7 +108,7 @@ def stress(material, part, E, S, Cinv, pressure, volume, work):
         S[2, 2, lane] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def tangent(material, part, E, Cinv, pressure, dE, dS, work):
     """dS~ (3, 3, G) for strain directions dE (3, 3, G) at a solved state (E, Cinv,
     pressure from :func:`stress`). dE[2, 2] is overwritten by the constraint's value."""
@@ -142,7 +147,7 @@ def tangent(material, part, E, Cinv, pressure, dE, dS, work):
         dS[2, 2, lane] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _inverse_stretch(E, out):
     """out (3, 3, G) = (2E + I)^-1 of solved strains E (3, 3, G) of an incompressible law,
     whose determinant is 1: the inverse is the adjugate."""

@@ -23,13 +23,15 @@ def det3(A, out):
 @njit(cache=True, error_model="numpy", inline="always")
 def product(A, B, out):
     """out = A B, all (3, 3, G); out must be neither input."""
+    # summed in a register, not in out: a sum held in memory is stored and loaded again
+    # at every term, as out might be an input for all the compiled code can tell
     for i in range(3):
         for j in range(3):
             for lane in range(LANES):
-                out[i, j, lane] = 0.0
-            for m in range(3):
-                for lane in range(LANES):
-                    out[i, j, lane] += A[i, m, lane] * B[m, j, lane]
+                acc = 0.0
+                for m in range(3):
+                    acc += A[i, m, lane] * B[m, j, lane]
+                out[i, j, lane] = acc
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -82,7 +82,7 @@ def point_geometry(element, functions, t, out):
     jac, jinv, q, det = out
     for i in range(3):
         for lane in range(LANES):
-            # summed in registers (see tensor3.product), node by node as before
+            # summed in registers (see tensor3.product), node by node
             r, s, n = 0.0, 0.0, 0.0
             for a in range(9):
                 half = 0.5 * he[a, lane]

@@ -96,29 +96,37 @@ class Scratch(NamedTuple):
     rhs: np.ndarray
 
 
+#: The trailing lengths of the work arrays, after their point and layer axes: one value,
+#: two, three or a lamina vector of five per lane; the tangents' 2 x 2 lamina components
+#: and the two tangents; a 3 x 3 tensor; a vector and a value at each of the nine nodes.
+#: :func:`group_arrays` makes the arrays with them and :func:`fixed_lanes` views them so.
+LANE, PAIR, TRIPLE, LAMINA = (LANES,), (2, LANES), (3, LANES), (5, LANES)
+PAIR_PAIR, TANGENTS, TENSOR = (2, 2, LANES), (2, 3, LANES), (3, 3, LANES)
+NODAL, NODE_VALUES = (9, 3, LANES), (9, LANES)
+
+
 @njit(cache=True, error_model="numpy")
 def group_arrays(npts, nt, nq, nb):
     """(:class:`Group`, :class:`Points`, :class:`Scratch`) for npts points, nt layers, nq
     Gauss points and nb volumetric fields."""
-    g = LANES
+    every, gauss = (npts, nt), (nq, nt)  # every point and layer; the Gauss points'
     group = Group(
-        members=np.zeros(g, dtype=np.int64), part=np.zeros(1, dtype=np.int64), xe=np.empty((9, 3, g)),
-        de=np.empty((9, 3, g)), ue=np.zeros((9, 3, g)),
-        ve=np.zeros((9, 3, g)), he=np.empty((9, g)), jac0=np.empty((npts, nt, 3, 3, g)),
-        axes0=np.empty((nq, nt, 3, 3, g)), state_stress=np.zeros((nq, nt, 5, g)), stress=np.zeros((nq, nt, 5, g)),
-        stretch=np.ones((nq, g)), fe=np.empty((9, 3, g)), ge=np.empty((9, 3, g)))
+        members=np.zeros(LANE, dtype=np.int64), part=np.zeros(1, dtype=np.int64), xe=np.empty(NODAL),
+        de=np.empty(NODAL), ue=np.zeros(NODAL), ve=np.zeros(NODAL), he=np.empty(NODE_VALUES),
+        jac0=np.empty(every + TENSOR), axes0=np.empty(gauss + TENSOR), state_stress=np.zeros(gauss + LAMINA),
+        stress=np.zeros(gauss + LAMINA), stretch=np.ones((nq,) + LANE), fe=np.empty(NODAL), ge=np.empty(NODAL))
     points = Points(
-        Q=np.empty((npts, nt, 3, 3, g)), jinv_all=np.empty((npts, nt, 3, 3, g)), G=np.empty((npts, nt, 2, 3, g)),
-        A=np.empty((npts, nt, 2, 2, g)), DV=np.empty((npts, nt, g)), EPS=np.empty((npts, nt, 5, g)),
-        cov_shear=np.empty((npts, nt, 2, g)), TS=np.empty((npts, nt, 2, g)), cbar=np.empty((npts, 3, g)),
-        T=np.empty((npts, 3, g)), SW=np.empty((nq, nt, 3, g)), FP=np.empty((nq, nt, 3, 3, g)),
-        LP=np.empty((nq, nt, 3, 3, g)), EPS0=np.empty((nq, nt, 5, g)), Bab=np.empty((nq, 3, g)))
+        Q=np.empty(every + TENSOR), jinv_all=np.empty(every + TENSOR), G=np.empty(every + TANGENTS),
+        A=np.empty(every + PAIR_PAIR), DV=np.empty(every + LANE), EPS=np.empty(every + LAMINA),
+        cov_shear=np.empty(every + PAIR), TS=np.empty(every + PAIR), cbar=np.empty((npts,) + TRIPLE),
+        T=np.empty((npts,) + TRIPLE), SW=np.empty(gauss + TRIPLE), FP=np.empty(gauss + TENSOR),
+        LP=np.empty(gauss + TENSOR), EPS0=np.empty(gauss + LAMINA), Bab=np.empty((nq,) + TRIPLE))
     scratch = Scratch(
-        jac=np.empty((3, 3, g)), F=np.empty((3, 3, g)), eg=np.empty((3, 3, g)), v=np.empty((3, 3, g)),
-        plane=np.zeros((3, 3, g)), glob=np.empty((3, 3, g)), local=np.empty((3, 3, g)), sg=np.empty((3, 3, g)),
-        gN=np.empty((9, 3, g)), gM=np.empty((9, 3, g)), s5=np.empty((5, g)), cov=np.empty((3, g)), delta=np.empty((3, g)),
-        det=np.empty(g), ones=np.ones(g), M=np.empty((11, 3, 3, g)), Emean=np.empty((3, 3, g)), pressure=np.empty(g),
-        volume=np.empty(g), normal=np.empty(g), Mb=np.empty((nb, nb)), rhs=np.empty(nb))
+        jac=np.empty(TENSOR), F=np.empty(TENSOR), eg=np.empty(TENSOR), v=np.empty(TENSOR), plane=np.zeros(TENSOR),
+        glob=np.empty(TENSOR), local=np.empty(TENSOR), sg=np.empty(TENSOR), gN=np.empty(NODAL), gM=np.empty(NODAL),
+        s5=np.empty(LAMINA), cov=np.empty(TRIPLE), delta=np.empty(TRIPLE), det=np.empty(LANE), ones=np.ones(LANE),
+        M=np.empty((11,) + TENSOR), Emean=np.empty(TENSOR), pressure=np.empty(LANE), volume=np.empty(LANE),
+        normal=np.empty(LANE), Mb=np.empty((nb, nb)), rhs=np.empty(nb))
     return group, points, scratch
 
 
@@ -128,25 +136,24 @@ def fixed_lanes(group, points, scratch):
     the compiled code (:func:`shellsim.fixed_shape.fixed_trailing`: the lane loops then
     vectorise), views for use inside the calling function only; scratch.Mb and rhs as
     they are."""
-    g, f = LANES, fixed_trailing
+    f = fixed_trailing
     group = Group(
-        members=f(group.members, (g,)), part=group.part, xe=f(group.xe, (9, 3, g)), de=f(group.de, (9, 3, g)),
-        ue=f(group.ue, (9, 3, g)), ve=f(group.ve, (9, 3, g)), he=f(group.he, (9, g)),
-        jac0=f(group.jac0, (3, 3, g)), axes0=f(group.axes0, (3, 3, g)), state_stress=f(group.state_stress, (5, g)),
-        stress=f(group.stress, (5, g)), stretch=f(group.stretch, (g,)), fe=f(group.fe, (9, 3, g)),
-        ge=f(group.ge, (9, 3, g)))
+        members=f(group.members, LANE), part=group.part, xe=f(group.xe, NODAL), de=f(group.de, NODAL),
+        ue=f(group.ue, NODAL), ve=f(group.ve, NODAL), he=f(group.he, NODE_VALUES), jac0=f(group.jac0, TENSOR),
+        axes0=f(group.axes0, TENSOR), state_stress=f(group.state_stress, LAMINA), stress=f(group.stress, LAMINA),
+        stretch=f(group.stretch, LANE), fe=f(group.fe, NODAL), ge=f(group.ge, NODAL))
     points = Points(
-        Q=f(points.Q, (3, 3, g)), jinv_all=f(points.jinv_all, (3, 3, g)), G=f(points.G, (2, 3, g)),
-        A=f(points.A, (2, 2, g)), DV=f(points.DV, (g,)), EPS=f(points.EPS, (5, g)),
-        cov_shear=f(points.cov_shear, (2, g)), TS=f(points.TS, (2, g)), cbar=f(points.cbar, (3, g)),
-        T=f(points.T, (3, g)), SW=f(points.SW, (3, g)), FP=f(points.FP, (3, 3, g)), LP=f(points.LP, (3, 3, g)),
-        EPS0=f(points.EPS0, (5, g)), Bab=f(points.Bab, (3, g)))
+        Q=f(points.Q, TENSOR), jinv_all=f(points.jinv_all, TENSOR), G=f(points.G, TANGENTS),
+        A=f(points.A, PAIR_PAIR), DV=f(points.DV, LANE), EPS=f(points.EPS, LAMINA),
+        cov_shear=f(points.cov_shear, PAIR), TS=f(points.TS, PAIR), cbar=f(points.cbar, TRIPLE),
+        T=f(points.T, TRIPLE), SW=f(points.SW, TRIPLE), FP=f(points.FP, TENSOR), LP=f(points.LP, TENSOR),
+        EPS0=f(points.EPS0, LAMINA), Bab=f(points.Bab, TRIPLE))
     scratch = Scratch(
-        jac=f(scratch.jac, (3, 3, g)), F=f(scratch.F, (3, 3, g)), eg=f(scratch.eg, (3, 3, g)),
-        v=f(scratch.v, (3, 3, g)), plane=f(scratch.plane, (3, 3, g)), glob=f(scratch.glob, (3, 3, g)),
-        local=f(scratch.local, (3, 3, g)), sg=f(scratch.sg, (3, 3, g)), gN=f(scratch.gN, (9, 3, g)),
-        gM=f(scratch.gM, (9, 3, g)), s5=f(scratch.s5, (5, g)), cov=f(scratch.cov, (3, g)),
-        delta=f(scratch.delta, (3, g)), det=f(scratch.det, (g,)), ones=f(scratch.ones, (g,)),
-        M=f(scratch.M, (11, 3, 3, g)), Emean=f(scratch.Emean, (3, 3, g)), pressure=f(scratch.pressure, (g,)),
-        volume=f(scratch.volume, (g,)), normal=f(scratch.normal, (g,)), Mb=scratch.Mb, rhs=scratch.rhs)
+        jac=f(scratch.jac, TENSOR), F=f(scratch.F, TENSOR), eg=f(scratch.eg, TENSOR), v=f(scratch.v, TENSOR),
+        plane=f(scratch.plane, TENSOR), glob=f(scratch.glob, TENSOR), local=f(scratch.local, TENSOR),
+        sg=f(scratch.sg, TENSOR), gN=f(scratch.gN, NODAL), gM=f(scratch.gM, NODAL), s5=f(scratch.s5, LAMINA),
+        cov=f(scratch.cov, TRIPLE), delta=f(scratch.delta, TRIPLE), det=f(scratch.det, LANE),
+        ones=f(scratch.ones, LANE), M=f(scratch.M, TENSOR), Emean=f(scratch.Emean, TENSOR),
+        pressure=f(scratch.pressure, LANE), volume=f(scratch.volume, LANE), normal=f(scratch.normal, LANE),
+        Mb=scratch.Mb, rhs=scratch.rhs)
     return group, points, scratch

@@ -1,8 +1,10 @@
-"""What of an explicit step runs outside the parallel element loop: the bench plate's full
-step against its force evaluation (the element loop with the loads) and the serial nodal
-gather of the element forces, best of several, on the threads asked. The rest of a step
-(velocities, moves, the works) loops over the nodes on one thread, and caps the speed-up
-on many cores (Amdahl). Prints one line; nothing is asserted.
+"""What of an explicit step runs outside the parallel element loop, and what of it still
+runs on one thread: the bench plate's full step against its force evaluation (the element
+loop with the loads), and of those the loads alone (their faces' loop runs on one thread),
+the nodal gather of the element forces and the node loops (velocities, the works' halves),
+best of several, on the threads asked. Run it at 1 and 2 threads: a part that does not
+halve is serial and caps the speed-up on many cores (Amdahl). Prints one line; nothing is
+asserted.
 
     .venv/bin/python benchmarks/serial_share.py [--divisions 100] [--threads 1]
 """
@@ -27,6 +29,7 @@ def main() -> None:
     from shellsim.deck import deck_from_data
     from shellsim.element.assembly import _gather_at_nodes
     from shellsim.execute import built_run
+    from shellsim.solver.explicit import applied_forces, half_works, update_velocities
     from shellsim.solver.outlook import quickest
     from shellsim.threads import ThreadChooser
 
@@ -39,13 +42,20 @@ def main() -> None:
     steps = 50
     step = quickest(lambda: sim.advance(sim.state.t + steps * dt, dt, steps), 5) / steps
     forces = quickest(lambda: sim.compute_forces(sim.state.t), 20)
-    nodal = sim.state.fields.f_int.copy()
-    gather = quickest(lambda: _gather_at_nodes(sim.model.body, sim.workspace.parts, nodal), 20)
-    per = 1e6 / sim.model.n_elements
-    print(f"{sim.model.n_elements:,} elements, {args.threads} thread(s): a step {per * step:.2f} us per element, "
-          f"its forces {per * forces:.2f}, the nodal gather {per * gather:.3f}; outside the forces "
-          f"{100 * (step - forces) / step:.1f}% of a step, the gather {100 * gather / step:.1f}%")
-
+    fields, space, model = sim.state.fields, sim.workspace, sim.model
+    loads = quickest(lambda: applied_forces(sim.state.t, model, fields, space), 20)
+    nodal, rotational = fields.f_int.copy(), fields.fr_int.copy()
+    gather = quickest(lambda: _gather_at_nodes(model.body, space.parts, fields.shape, nodal, rotational), 20)
+    v, w = fields.v.copy(), fields.w.copy()  # the velocities' update below moves them: put back after
+    velocities = quickest(lambda: update_velocities(fields, model.constraints.projector, model.constraints.rot_free,
+                                                    0.0, dt, space.sums), 20)
+    fields.v[:], fields.w[:] = v, w
+    works = quickest(lambda: half_works(fields, space, dt), 20)
+    per = 1e6 / model.n_elements
+    print(f"{model.n_elements:,} elements, {args.threads} thread(s), us per element: a step {per * step:.3f}, "
+          f"its forces {per * forces:.3f} (the loads {per * loads:.3f}, the nodal gather {per * gather:.3f}), "
+          f"the velocities {per * velocities:.3f}, a half of the works {per * works:.3f}; outside the forces "
+          f"{100 * (step - forces) / step:.1f}% of a step, the loads {100 * loads / step:.1f}%")
 
 if __name__ == "__main__":
     main()

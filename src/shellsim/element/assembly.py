@@ -15,7 +15,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import get_num_threads, njit, prange
 
-from .frames import director_increments, to_rotational
+from .frames import director_increments, rotational_at
 from .groups import (gather_element_values, gather_members_shape, gather_nodal_vectors, group_count,
                      part_group_members, scatter_element_values)
 from .work_arrays import group_arrays
@@ -139,40 +139,43 @@ def run_groups(response, start, stop, steps, rule, body, material, shape, ux, ud
 def after_groups(steps, body, shape, parts, f, fr):
     """What follows the groups' responses in ``parts``: their nodal sums f (n, 3) and fr
     (n, 2), and the fibre lengths of ``shape`` updated when ``steps`` say so."""
-    _gather_at_nodes(body, parts, f)
-    to_rotational(parts.g, shape.d, shape.e1, fr)
+    _gather_at_nodes(body, parts, shape, f, fr)
     if steps.update_lengths:
         _update_fibre_lengths(body, parts, shape.h, steps.convected)
 
 
-@njit(cache=True, error_model="numpy")
-def _gather_at_nodes(body, parts, f):
+@njit(cache=True, parallel=True, error_model="numpy")
+def _gather_at_nodes(body, parts, shape, f, fr):
     """The nodal sums of the element forces in ``parts`` (:class:`Assembly`), each node's
-    slots in ascending order: f (n, 3) from fe, parts.g from ge."""
-    g = parts.g
-    for node in range(g.shape[0]):
-        f[node, :] = 0.0
-        g[node, :] = 0.0
-        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
-            e, a = divmod(body.slots[slot], 9)
+    slots in ascending order, node by node over the threads: f (n, 3) from fe, parts.g
+    from ge, and from those the rotational forces fr (n, 2) on the directors of ``shape``."""
+    g, fe, ge, slots, node_slots, d, e1 = parts.g, parts.fe, parts.ge, body.slots, body.node_slots, shape.d, shape.e1
+    for node in prange(g.shape[0]):
+        for i in range(3):
+            f[node, i] = 0.0
+            g[node, i] = 0.0
+        for slot in range(node_slots[node], node_slots[node + 1]):
+            e, a = divmod(slots[slot], 9)
             for i in range(3):
-                f[node, i] += parts.fe[e, a, i]
-                g[node, i] += parts.ge[e, a, i]
+                f[node, i] += fe[e, a, i]
+                g[node, i] += ge[e, a, i]
+        rotational_at(node, g, d, e1, fr)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy")
 def _update_fibre_lengths(body, parts, h, incremental):
     """h (n,) = (h, incremental; else h0) x the volume-weighted mean of the normal
     stretches of the node's elements (``parts``), summed in ascending element order."""
-    for node in range(h.shape[0]):
+    slots, node_slots, h0, stretch, volume = body.slots, body.node_slots, body.h0, parts.stretch, parts.volume
+    for node in prange(h.shape[0]):
         weighted = 0.0
         weights = 0.0
-        for slot in range(body.node_slots[node], body.node_slots[node + 1]):
-            e = body.slots[slot] // 9
-            weighted += parts.stretch[e]
-            weights += parts.volume[e]
+        for slot in range(node_slots[node], node_slots[node + 1]):
+            e = slots[slot] // 9
+            weighted += stretch[e]
+            weights += volume[e]
         if weights > 0.0:
-            h[node] = (h[node] if incremental else body.h0[node]) * weighted / weights
+            h[node] = (h[node] if incremental else h0[node]) * weighted / weights
 
 
 # inlined into the time step (shellsim.solver.explicit.forces): a compiled layer of its own

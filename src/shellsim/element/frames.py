@@ -7,7 +7,7 @@ integration points is :func:`shellsim.element.kinematics.lamina_frame`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True, inline="always")
@@ -82,14 +82,20 @@ def rotate_directors(d, e1, nodes, dtheta):
         rotate_director(d[nodes[k]], e1[nodes[k]], dtheta[k, 0], dtheta[k, 1])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, parallel=True, error_model="numpy")
 def to_rotational(g, d, e1, out):
     """Rotational DOF forces (n, 2) from director-conjugate forces g (n, 3):
-    (-e1f.g, -e2f.g), e2f = d x e1f."""
-    for n in range(g.shape[0]):
-        e2x, e2y, e2z = cross(d[n], e1[n])
-        out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
-        out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
+    (-e1f.g, -e2f.g), e2f = d x e1f; node by node over the threads."""
+    for n in prange(g.shape[0]):
+        rotational_at(n, g, d, e1, out)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def rotational_at(n, g, d, e1, out):
+    """:func:`to_rotational` at node n."""
+    e2x, e2y, e2z = cross(d[n], e1[n])
+    out[n, 0] = -(e1[n, 0] * g[n, 0] + e1[n, 1] * g[n, 1] + e1[n, 2] * g[n, 2])
+    out[n, 1] = -(e2x * g[n, 0] + e2y * g[n, 1] + e2z * g[n, 2])
 
 
 @njit(cache=True, error_model="numpy")

@@ -11,7 +11,7 @@ from numba import njit
 
 from ..array_copy import copy_into
 from ..curve_tables import factor
-from ..element.frames import rotate_director, to_rotational
+from ..element.frames import rotate_director, rotational_at
 from ..element.shape import EDGE_DN, EDGE_N, EDGE_W
 from ..mesh import inverse_jacobians
 from ..table_types import Name, Vec3
@@ -184,7 +184,7 @@ def add_tangent(t, model, shape, loads, step_u, step_r, k):
                 g[0, 0] = moment[1] * d[0, 2] - moment[2] * d[0, 1]
                 g[0, 1] = moment[2] * d[0, 0] - moment[0] * d[0, 2]
                 g[0, 2] = moment[0] * d[0, 1] - moment[1] * d[0, 0]
-                to_rotational(g, d, e1, fr)
+                rotational_at(0, g, d, e1, fr)
                 for r in range(2):
                     block[r, j] -= sign * fr[0, r] / (2.0 * step_r)
         e, a = divmod(body.slots[body.node_slots[node]], 9)

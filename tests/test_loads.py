@@ -161,3 +161,35 @@ def test_scalar_fields_survive_a_mesh_file_round_trip(tmp_path):
     again = build_mesh(parse_deck(mapped(tmp_path / "again.vtu")))
     np.testing.assert_array_equal(again.point_fields["wall_pressure"], mesh.point_fields["wall_pressure"])
     np.testing.assert_array_equal(again.cell_fields["region_pressure"], mesh.cell_fields["region_pressure"])
+
+
+def test_the_pressures_summed_node_by_node_over_the_threads_are_a_loop_over_the_faces_to_the_bit():
+    """The follower pressures' forces (shellsim.loads.pressure.add_face_forces: the faces'
+    area vectors face by face, then each node's sum over its faces in face order) equal
+    those of a loop over the faces that adds each one's forces (face_forces) at its nodes
+    in turn, every bit: three tables, the bottom, top and mid faces of the whole plate, so
+    that every node sums faces of three tables, on a shape moved off the plane."""
+    from shellsim.bundles import Shape
+    from shellsim.loads.pressure import add_face_forces, face_forces
+
+    text = deck_text(f'builder = "rectangle"\nlength = {LENGTH}\nwidth = {WIDTH}', "[mesh]\ndivisions = { length = 5, width = 3 }\n"
+                     + "".join(f'[[load]]\ntype = "pressure"\nvalue = {value}\nface = "{face}"\n'
+                               for value, face in ((1.5, "bottom"), (-0.7, "top"), (2.25, "mid"))))
+    deck = parse_deck(text)
+    model = build_model(deck, build_mesh(deck))
+    faces = model.loads.pressure
+    assert len(faces.elements) == 3 * model.n_elements
+    rng = np.random.default_rng(3)
+    shape = Shape(x=model.x0 + 0.05 * rng.standard_normal(model.x0.shape), d=model.d0.copy(), e1=model.e1f0.copy(),
+                  h=model.h0 * (1.0 + 0.1 * rng.random(model.n_nodes)))
+    f, g = rng.standard_normal((2, model.n_nodes, 3))  # the kinds before add onto these
+    start, expected_f, expected_g = f.copy(), f.copy(), g.copy()
+    add_face_forces(model.rule, model.body.conn, model.curves, 0.0, shape, faces, f, g)
+    for m, element in enumerate(faces.elements):
+        nodes = model.body.conn[element]
+        fe, ge = expected_f[nodes], expected_g[nodes]
+        face_forces(model.rule, shape.x[nodes], shape.d[nodes], shape.h[nodes], faces.face[m], faces.values[m], fe, ge)
+        expected_f[nodes], expected_g[nodes] = fe, ge
+    assert np.abs(f - start).min() > 0.0  # every node carries faces' forces
+    np.testing.assert_array_equal(f, expected_f)
+    np.testing.assert_array_equal(g, expected_g)

@@ -11,7 +11,9 @@ A kind is a module of this package with
   nodal forces, a mapped pressure is a follower pressure with values of its own);
 and, when it has kernels of its own,
 - ``Bundle``: a NamedTuple of arrays, every field with the loads along its first axis
-  (the registry concatenates one per table);
+  (the registry concatenates one per table), and where its kernels need what only all
+  of its tables together tell (the pressure's map from the nodes to their faces)
+  ``joined(bundle, scene)``, the concatenated bundle completed;
 - ``empty(scene)``, a bundle of none, where the kind is compiled into every scene (the
   everyday loads, nodal and pressure: were each left out where unused, every mix of them
   would type a model of its own and compile its time loop again); a kind without it is
@@ -141,8 +143,13 @@ def build_loads(tables: dict[str, list], scene: LoadScene) -> Loads:
             except MeshError as error:
                 raise MeshError(f"{key}[{i}] ({table.type} on '{table.set}'): {error}") from None
             parts[type(made)].append(made)
-    return Loads(*(_concatenate(parts[kind.Bundle]) if parts[kind.Bundle]
+    return Loads(*(_joined(kind, _concatenate(parts[kind.Bundle]), scene) if parts[kind.Bundle]
                    else kind.empty(scene) if hasattr(kind, "empty") else None for kind in CARRIERS))
+
+
+def _joined(kind, bundle: NamedTuple, scene: LoadScene) -> NamedTuple:
+    """``bundle``, every table's of ``kind``, completed by the kind's ``joined``."""
+    return kind.joined(bundle, scene) if hasattr(kind, "joined") else bundle
 
 
 def _concatenate(bundles: list) -> NamedTuple:

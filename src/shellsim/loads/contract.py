@@ -17,7 +17,7 @@ EVERY = ("TABLES", "build")
 CARRYING = ("Bundle", "add_forces")
 #: By role: (the hooks it must have beyond EVERY, those it may have).
 ROLES = {
-    "load": ((), ("Bundle", "add_forces", "empty", "add_tangent", "couplings")),
+    "load": ((), ("Bundle", "add_forces", "empty", "joined", "add_tangent", "couplings")),
     "contact": ((*CARRYING, "calibrate", "step_share", "item_forces", "item_energies", "item_gaps", "FORCE_TOTAL",
                  "SIDES"),
                 ("add_tangent", "add_friction", "friction_couplings", "deepest", "farthest_moved", "couplings", "empty",

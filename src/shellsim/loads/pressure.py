@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import ClassVar, Literal, NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ..array_copy import copy_into
 from ..curve_tables import factor
@@ -51,12 +51,21 @@ TABLES = (Pressure,)
 class Bundle(NamedTuple):
     """Follower pressure on element faces (P,): elements, face (-1 bottom, 0 mid, +1 top),
     values (P, nq) [force/length^2] at the face's Gauss points, curve (index into
-    :class:`shellsim.bundles.Curves`, -1 constant)."""
+    :class:`shellsim.bundles.Curves`, -1 constant); scratch of the forces' two passes:
+    pressure (P, nq) the values at the time, area (P, nq, 3) the face's area vectors at its
+    Gauss points. Over all tables (:func:`joined`; empty in one table's): the K loaded
+    nodes, node_end (K,) where each one's slots end in slots (9P,), face * 9 + the node's
+    place in it, in face order."""
 
     elements: np.ndarray
     face: np.ndarray
     values: np.ndarray
     curve: np.ndarray
+    pressure: np.ndarray
+    area: np.ndarray
+    nodes: np.ndarray
+    node_end: np.ndarray
+    slots: np.ndarray
 
 
 def empty(scene) -> Bundle:
@@ -66,10 +75,22 @@ def empty(scene) -> Bundle:
 
 def faces(elements: np.ndarray, face: int, values: np.ndarray, curve: int) -> Bundle:
     """Pressures ``values`` (P, nq) at the Gauss points of one face of ``elements`` (P,),
-    following curve ``curve``."""
+    following curve ``curve``; its nodes' map still empty (:func:`joined`)."""
     count = len(elements)
+    values = np.asarray(values, dtype=float)
+    none = np.zeros(0, dtype=np.int64)
     return Bundle(elements=np.asarray(elements, dtype=np.int64), face=np.full(count, face, dtype=np.int64),
-                  values=np.asarray(values, dtype=float), curve=np.full(count, curve, dtype=np.int64))
+                  values=values, curve=np.full(count, curve, dtype=np.int64), pressure=np.zeros_like(values),
+                  area=np.zeros((*values.shape, 3)), nodes=none, node_end=none, slots=none)
+
+
+def joined(loads: Bundle, scene) -> Bundle:
+    """``loads`` of every table with the map from their nodes to the faces on them, in face
+    order, with which each node sums its forces on its own (:func:`add_face_forces`)."""
+    on_faces = scene.body.conn[loads.elements].ravel()  # (9P,) face by face
+    order = np.argsort(on_faces, kind="stable")  # by node, each node's in face order
+    nodes, counts = np.unique(on_faces, return_counts=True)
+    return loads._replace(nodes=nodes, node_end=np.cumsum(counts), slots=order.astype(np.int64))
 
 
 def build(table: Pressure, scene) -> Bundle | nodal.Bundle:
@@ -82,8 +103,41 @@ def build(table: Pressure, scene) -> Bundle | nodal.Bundle:
         return faces(elements, FACES[table.face], values, curve)
     f, g = np.zeros((scene.mesh.n_nodes, 3)), np.zeros((scene.mesh.n_nodes, 3))
     add_face_forces(scene.rule, scene.body.conn, scene.curves, 0.0, scene.initial,
-                    faces(elements, FACES[table.face], values, -1), f, g)
+                    joined(faces(elements, FACES[table.face], values, -1), scene), f, g)
     return nodal.dead_forces(f, curve)
+
+
+#: The nodes of an element's own arrays (9, 3) in their order, for :func:`face_area`.
+OWN_NODES = np.arange(9)
+
+
+@njit(cache=True, inline="always")
+def face_area(rule, x, d, h, nodes, t, p):
+    """The area vector g_r x g_s (3-tuple) at Gauss point p of the face t (-1 bottom, 0
+    mid-surface, +1 top) of the element on ``nodes`` (9,) of x, d (n, 3), h (n,)."""
+    yr0 = yr1 = yr2 = ys0 = ys1 = ys2 = 0.0
+    for a in range(9):
+        node = nodes[a]
+        pos = fibre_point(x[node, 0], d[node, 0], h[node], t)
+        yr0 += rule.dNr[p, a] * pos
+        ys0 += rule.dNs[p, a] * pos
+        pos = fibre_point(x[node, 1], d[node, 1], h[node], t)
+        yr1 += rule.dNr[p, a] * pos
+        ys1 += rule.dNs[p, a] * pos
+        pos = fibre_point(x[node, 2], d[node, 2], h[node], t)
+        yr2 += rule.dNr[p, a] * pos
+        ys2 += rule.dNs[p, a] * pos
+    return cross((yr0, yr1, yr2), (ys0, ys1, ys2))
+
+
+@njit(cache=True, inline="always")
+def _weight(rule, face, pressure, p, a):
+    """The weight of node a's share at Gauss point p of a face (-1, 0, +1) under
+    ``pressure`` there. Positive pressure pushes into the shell, i.e. along +n on the
+    bottom face and the mid-surface and along -n on the top face, n = g_r x g_s / |.|
+    (the directors' side)."""
+    sign = -1.0 if face > 0 else 1.0
+    return sign * pressure * rule.N[p, a] * rule.wq[p]
 
 
 @njit(cache=True)
@@ -91,58 +145,47 @@ def face_forces(rule, xe, de, he, face, pressure, fe, ge):
     """Adds the forces of the pressures (nq,) [force/length^2] at the Gauss points of one
     element's ``face`` (-1 bottom, 0 mid-surface, +1 top) to fe, ge (9, 3):
     translational and director-conjugate. The element's nodes: xe, de (9, 3) positions
-    and directors, he (9,) fibre lengths.
-
-    Positive pushes into the shell, i.e. along +n on the bottom face and the mid-surface
-    and along -n on the top face, n = g_r x g_s / |.| (the directors' side). Forces act
-    where the face is, so the director-conjugate part carries their lever arm.
+    and directors, he (9,) fibre lengths. Forces act where the face is, so the
+    director-conjugate part carries their lever arm (:func:`_weight` for their sense).
     """
-    N, dNr, dNs, wq = rule.N, rule.dNr, rule.dNs, rule.wq
     t = float(face)
-    sign = -1.0 if face > 0 else 1.0
-    yr = np.empty(3)
-    ys = np.empty(3)
-    area = np.empty(3)
-    for p in range(wq.shape[0]):
-        yr[:] = 0.0
-        ys[:] = 0.0
+    for p in range(rule.wq.shape[0]):
+        area = face_area(rule, xe, de, he, OWN_NODES, t, p)
         for a in range(9):
-            for i in range(3):
-                pos = fibre_point(xe[a, i], de[a, i], he[a], t)
-                yr[i] += dNr[p, a] * pos
-                ys[i] += dNs[p, a] * pos
-        area[0], area[1], area[2] = cross(yr, ys)
-        for a in range(9):
-            w = sign * pressure[p] * N[p, a] * wq[p]
+            w = _weight(rule, face, pressure[p], p, a)
             for i in range(3):
                 fe[a, i] += w * area[i]
                 ge[a, i] += w * area[i] * t * 0.5 * he[a]
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def add_face_forces(rule, conn, curves, t, shape, loads, f, g):
-    """Adds the forces of the pressures of ``loads`` (:class:`Bundle`) at time t to f and g
-    (n, 3) (:func:`face_forces`). rule: the element's :class:`~shellsim.bundles.Rule`;
-    conn (ne, 9); curves: :class:`~shellsim.bundles.Curves`; shape: the current
-    :class:`~shellsim.bundles.Shape`."""
-    if loads.elements.shape[0] == 0:
-        return  # no face: nothing allocated in the time loop
-    xe, de, he = np.empty((9, 3)), np.empty((9, 3)), np.empty(9)
-    fe, ge = np.empty((9, 3)), np.empty((9, 3))
-    pressure = np.empty(loads.values.shape[1])
-    for m in range(loads.elements.shape[0]):
-        c = factor(curves, loads.curve[m], t)
-        for p in range(pressure.shape[0]):
-            pressure[p] = loads.values[m, p] * c
-        nodes = conn[loads.elements[m]]
-        gather_nodes(shape, nodes, xe, de, he)
-        for a in range(9):
-            copy_into(f[nodes[a]], fe[a])  # summed in place: the nodal sums keep the order of every step
-            copy_into(g[nodes[a]], ge[a])
-        face_forces(rule, xe, de, he, loads.face[m], pressure, fe, ge)
-        for a in range(9):
-            copy_into(fe[a], f[nodes[a]])
-            copy_into(ge[a], g[nodes[a]])
+    """Adds the forces of the pressures of ``loads`` (:class:`Bundle`, :func:`joined`) at
+    time t to f and g (n, 3), as :func:`face_forces` does face by face, over the threads:
+    the faces' area vectors first, face by face, then each node's forces, its faces' in
+    face order (the sums of a loop over the faces, in every bit). rule: the element's
+    :class:`~shellsim.bundles.Rule`; conn (ne, 9); curves:
+    :class:`~shellsim.bundles.Curves`; shape: the current :class:`~shellsim.bundles.Shape`."""
+    x, d, h, elements, face, pressure, area = shape.x, shape.d, shape.h, loads.elements, loads.face, loads.pressure, loads.area
+    values, curve, nodes, node_end, slots = loads.values, loads.curve, loads.nodes, loads.node_end, loads.slots
+    if elements.shape[0] == 0:
+        return  # no face: no parallel loop started in the time step
+    for m in prange(elements.shape[0]):
+        c = factor(curves, curve[m], t)
+        on = conn[elements[m]]
+        for p in range(values.shape[1]):
+            pressure[m, p] = values[m, p] * c
+            area[m, p, 0], area[m, p, 1], area[m, p, 2] = face_area(rule, x, d, h, on, float(face[m]), p)
+    for k in prange(nodes.shape[0]):
+        node = nodes[k]
+        for slot in range(node_end[k - 1] if k > 0 else 0, node_end[k]):
+            m, a = divmod(slots[slot], 9)
+            t_face = float(face[m])
+            for p in range(values.shape[1]):
+                w = _weight(rule, face[m], pressure[m, p], p, a)
+                for i in range(3):
+                    f[node, i] += w * area[m, p, i]
+                    g[node, i] += w * area[m, p, i] * t_face * 0.5 * h[node]
 
 
 @njit(cache=True)

@@ -122,6 +122,20 @@ def _half_work(f, fr, dx, w, step, node):
     return work
 
 
+@njit(cache=True, inline="always")
+def _weighted_dots(total, node, translations, rotations):
+    """``total`` + mass a.b + rotary p.q scale at ``node``, translations (mass, a, b) with
+    a, b (n, 3) and rotations (rotary, p, q, scale) with p, q (n, 2), added term by term:
+    a block's sum of the kinetic energy or of the damping's work."""
+    mass, a, b = translations
+    rotary, p, q, scale = rotations
+    for i in range(3):
+        total += mass * a[node, i] * b[node, i]
+    for j in range(2):
+        total += rotary * p[node, j] * q[node, j] * scale
+    return total
+
+
 @njit(cache=True, parallel=True)
 def half_works(fields, space, step):
     """Half the works of the step ``step`` long that ``space.dx`` and ``fields.w`` make:
@@ -150,10 +164,7 @@ def kinetic_energy(v, w, mt, mr, sums):
         first, last = _block(b, n)
         energy = 0.0
         for node in range(first, last):
-            for i in range(3):
-                energy += 0.5 * mt[node] * v[node, i] * v[node, i]
-            for j in range(2):
-                energy += 0.5 * mr[node] * w[node, j] * w[node, j]
+            energy = _weighted_dots(energy, node, (0.5 * mt[node], v, v), (0.5 * mr[node], w, w, 1.0))
         sums[b, 0] = energy
     return _in_order(sums, 0)
 
@@ -229,10 +240,7 @@ def move(fields, space, step, damping):
             dd[node, 0], dd[node, 1], dd[node, 2] = d[node, 0] - d0, d[node, 1] - d1, d[node, 2] - d2
             theta[node, 0] += step * w[node, 0]
             theta[node, 1] += step * w[node, 1]
-            for i in range(3):
-                damped += damping * mt[node] * v[node, i] * dx[node, i]
-            for j in range(2):
-                damped += damping * mr[node] * w[node, j] * w[node, j] * step
+            damped = _weighted_dots(damped, node, (damping * mt[node], v, dx), (damping * mr[node], w, w, step))
         sums[b, 0] = damped
     return _in_order(sums, 0)
 

@@ -11,6 +11,7 @@ import numpy as np
 from numba import njit, prange
 
 from ..array_copy import copy_into
+from ..bundles import slots_by_node
 from ..curve_tables import factor
 from ..element.frames import cross
 from ..element.groups import gather_nodes
@@ -53,9 +54,9 @@ class Bundle(NamedTuple):
     values (P, nq) [force/length^2] at the face's Gauss points, curve (index into
     :class:`shellsim.bundles.Curves`, -1 constant); scratch of the forces' two passes:
     pressure (P, nq) the values at the time, area (P, nq, 3) the face's area vectors at its
-    Gauss points. Over all tables (:func:`joined`; empty in one table's): the K loaded
-    nodes, node_end (K,) where each one's slots end in slots (9P,), face * 9 + the node's
-    place in it, in face order."""
+    Gauss points. Over all tables (:func:`joined`; empty in one table's): each node's faces
+    as compressed rows, node_slots (n + 1,) into slots (9P,) face * 9 + the node's place
+    in it, in face order (:func:`shellsim.bundles.slots_by_node`)."""
 
     elements: np.ndarray
     face: np.ndarray
@@ -63,8 +64,7 @@ class Bundle(NamedTuple):
     curve: np.ndarray
     pressure: np.ndarray
     area: np.ndarray
-    nodes: np.ndarray
-    node_end: np.ndarray
+    node_slots: np.ndarray
     slots: np.ndarray
 
 
@@ -81,16 +81,14 @@ def faces(elements: np.ndarray, face: int, values: np.ndarray, curve: int) -> Bu
     none = np.zeros(0, dtype=np.int64)
     return Bundle(elements=np.asarray(elements, dtype=np.int64), face=np.full(count, face, dtype=np.int64),
                   values=values, curve=np.full(count, curve, dtype=np.int64), pressure=np.zeros_like(values),
-                  area=np.zeros((*values.shape, 3)), nodes=none, node_end=none, slots=none)
+                  area=np.zeros((*values.shape, 3)), node_slots=none, slots=none)
 
 
 def joined(loads: Bundle, scene) -> Bundle:
     """``loads`` of every table with the map from their nodes to the faces on them, in face
     order, with which each node sums its forces on its own (:func:`add_face_forces`)."""
-    on_faces = scene.body.conn[loads.elements].ravel()  # (9P,) face by face
-    order = np.argsort(on_faces, kind="stable")  # by node, each node's in face order
-    nodes, counts = np.unique(on_faces, return_counts=True)
-    return loads._replace(nodes=nodes, node_end=np.cumsum(counts), slots=order.astype(np.int64))
+    node_slots, slots = slots_by_node(scene.body.conn[loads.elements], scene.mesh.n_nodes)
+    return loads._replace(node_slots=node_slots, slots=slots)
 
 
 def build(table: Pressure, scene) -> Bundle | nodal.Bundle:
@@ -167,7 +165,7 @@ def add_face_forces(rule, conn, curves, t, shape, loads, f, g):
     :class:`~shellsim.bundles.Rule`; conn (ne, 9); curves:
     :class:`~shellsim.bundles.Curves`; shape: the current :class:`~shellsim.bundles.Shape`."""
     x, d, h, elements, face, pressure, area = shape.x, shape.d, shape.h, loads.elements, loads.face, loads.pressure, loads.area
-    values, curve, nodes, node_end, slots = loads.values, loads.curve, loads.nodes, loads.node_end, loads.slots
+    values, curve, node_slots, slots = loads.values, loads.curve, loads.node_slots, loads.slots
     if elements.shape[0] == 0:
         return  # no face: no parallel loop started in the time step
     for m in prange(elements.shape[0]):
@@ -176,9 +174,8 @@ def add_face_forces(rule, conn, curves, t, shape, loads, f, g):
         for p in range(values.shape[1]):
             pressure[m, p] = values[m, p] * c
             area[m, p, 0], area[m, p, 1], area[m, p, 2] = face_area(rule, x, d, h, on, float(face[m]), p)
-    for k in prange(nodes.shape[0]):
-        node = nodes[k]
-        for slot in range(node_end[k - 1] if k > 0 else 0, node_end[k]):
+    for node in prange(node_slots.shape[0] - 1):
+        for slot in range(node_slots[node], node_slots[node + 1]):
             m, a = divmod(slots[slot], 9)
             t_face = float(face[m])
             for p in range(values.shape[1]):

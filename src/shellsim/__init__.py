@@ -33,6 +33,14 @@ def _numba_cache_dir() -> str:
 # Read by numba when it is first imported, or again here when it was imported before shellsim.
 os.environ.setdefault("NUMBA_OPT", "1")
 os.environ.setdefault("NUMBA_CACHE_DIR", _numba_cache_dir())
+# libgomp, the OpenMP runtime numba's parallel loops run on, lets a thread that waits at a
+# loop's end spin 300,000 turns before it sleeps: on a busy machine the spinning threads
+# hold the CPUs the thread they wait for needs (two threads ran 2-80x slower than one).
+# 10,000 turns still bridge the gaps between a step's loops on an idle machine
+# (docs/verification.md, "Threads on a busy machine"). Read when numba starts its threads;
+# the user's own OMP_WAIT_POLICY or GOMP_SPINCOUNT is kept.
+if "OMP_WAIT_POLICY" not in os.environ:
+    os.environ.setdefault("GOMP_SPINCOUNT", "10000")
 if "numba" in sys.modules:  # imported first, it has read its settings: read them again
     sys.modules["numba"].core.config.reload_config()
 

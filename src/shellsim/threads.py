@@ -5,7 +5,9 @@ container or a batch job given 2 of a node's 64 cores), not the machine's count 
 starts from. Within that, a run's steps use whichever of one thread or all of them is
 faster now (:class:`ThreadChooser`): on a machine other work keeps busy, the threads of a
 parallel loop wait at its end for the one the scheduler took away, and two threads ran 7x
-slower than one. The results do not depend on the count (:mod:`shellsim.element.assembly`).
+slower than one. How long a waiting thread spins before it sleeps is set where the
+package starts (:mod:`shellsim`, GOMP_SPINCOUNT): spinning threads held the CPUs the late
+one needed. The results do not depend on the count (:mod:`shellsim.element.assembly`).
 """
 
 from __future__ import annotations

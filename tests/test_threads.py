@@ -89,6 +89,20 @@ def test_kernels_compile_at_llvm_level_1_unless_told_and_each_level_has_its_own_
     assert (level, told_level) == ("1", "3") and folder != told_folder
 
 
+def test_waiting_threads_spin_10000_turns_unless_the_user_says_how_they_wait():
+    """shellsim shortens libgomp's spin before a waiting thread sleeps (300,000 turns held
+    the CPUs a late thread needed on a busy machine: docs/verification.md, "Threads on a
+    busy machine"); the user's own GOMP_SPINCOUNT or OMP_WAIT_POLICY is kept."""
+    probe = "import shellsim, os; print(os.environ.get('GOMP_SPINCOUNT', 'unset'))"
+    env = {k: v for k, v in os.environ.items() if k not in ("GOMP_SPINCOUNT", "OMP_WAIT_POLICY")}
+
+    def spins(**told):
+        return subprocess.run([sys.executable, "-c", probe], env=env | told, capture_output=True, text=True,
+                              check=True).stdout.strip()
+
+    assert (spins(), spins(GOMP_SPINCOUNT="500"), spins(OMP_WAIT_POLICY="PASSIVE")) == ("10000", "500", "unset")
+
+
 def test_numba_imported_before_shellsim_still_uses_its_cache_folder_and_level():
     """A script that imports numba first had numba read its settings before shellsim set
     them: its kernels compiled at level 3 into the source tree's __pycache__, where numba

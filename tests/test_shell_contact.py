@@ -585,3 +585,45 @@ def test_a_face_s_search_box_is_grown_by_the_reach_of_its_own_pass(tmp_path):
     assert own.any() and not own.all()
     np.testing.assert_allclose(loads.reach[own], 0.02 * (1.0 + TOUCHING), rtol=1e-9)
     np.testing.assert_allclose(loads.reach[~own], 0.06 * (1.0 + TOUCHING), rtol=1e-9)
+
+
+def test_the_faces_listed_for_each_node_find_the_pairs_the_grid_finds_as_the_shells_slide(tmp_path):
+    """Two stacked plates (6 x 6 on 5 x 5, touching) in one self-contact, the upper slid
+    sideways in steps from far below the lists' skin to twice it, jittered: at every
+    step each contact node takes the face a search of the whole grid takes, with the same
+    forces, and the lists are made again only when the motion since they were made
+    could have brought a face from outside a list within reach."""
+    from shellsim.bundles import Shape
+    from shellsim.loads import calibrate
+    from shellsim.loads.shell_contact import (SKIN, _at_initial_thickness, _candidates, _contact_forces, _grid,
+                                              _pair_forces, _work)
+    from shellsim.model import build_model
+
+    path = stacked_plates(tmp_path / "plates.vtu", 6, 5)
+    deck = parse_deck(deck_text(f'builder = "file"\npath = "{path.as_posix()}"',
+                                '[[contact]]\ntype = "shells"\nname = "both"\nset = "all"\n'))
+    model = build_model(deck, build_mesh(deck))
+    calibrate(model, np.ones(model.n_nodes), np.ones(model.n_nodes), 1.0)
+    loads = model.loads.shell_contact
+    upper = np.unique(model.conn[36:])
+    rng = np.random.default_rng(1)
+    x = model.x0.copy()
+    relisted, steps, out = 0, 0, np.empty((10, 3))
+    for step in np.geomspace(1e-3, 2.0, 12) * SKIN * 0.01:  # the reach is about the thickness, 0.01
+        for _ in range(4):
+            x[upper, 0] += step
+            x[upper] += rng.uniform(-0.1, 0.1, (len(upper), 3)) * step
+            shape = _at_initial_thickness(model, Shape(x=x, d=model.d0.copy(), e1=model.e1f0.copy(), h=model.h0.copy()))
+            listed_at = loads.listed_at.copy()
+            _contact_forces(model, shape, loads)
+            relisted += not np.array_equal(listed_at, loads.listed_at)
+            steps += 1
+            listed_pairs, listed_forces = loads.touches.copy(), loads.touch_forces.copy()
+            grid, work = _grid(shape, loads, 1.0), _work()
+            searched = np.array([_candidates(shape, loads, m, grid, work, True) for m in range(len(loads.nodes))])
+            np.testing.assert_array_equal(listed_pairs, searched)
+            for m in np.flatnonzero(searched >= 0):  # the same forces, to the bit
+                _pair_forces(shape.x, shape.h, loads, m, searched[m], out, work)
+                np.testing.assert_array_equal(listed_forces[m], out)
+    assert (listed_pairs >= 0).sum() > 50
+    assert 2 < relisted < steps / 2

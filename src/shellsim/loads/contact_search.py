@@ -1,12 +1,12 @@
 """The search of shell contact (:mod:`shellsim.loads.shell_contact`), compiled: which face
-a node may touch (a bucket grid rebuilt at every call) and the nearest point of a
-9-node face's quadratic mid-surface to a point (Newton on the natural coordinates).
+a node may touch (each face's box and a bucket grid of the boxes) and the nearest point
+of a 9-node face's quadratic mid-surface to a point (Newton on the natural coordinates).
 
 Broad phase: each face's box is the box of its nine nodes grown by the reach of the
 contact (the thickness offsets); the grid's cells are as wide as the widest box, so a
 box covers at most 2 x 2 x 2 cells and a node only reads the faces listed in its own
 cell. Cells are hashed into a table of twice as many buckets as faces and the lists are
-made by a counting sort, so the grid costs O(faces + nodes) a call and allocates nothing.
+made by a counting sort, so the grid costs O(faces) a call and allocates nothing.
 """
 
 from __future__ import annotations
@@ -61,14 +61,21 @@ def _surface(x, nodes, r, s, point, scratch):
     derivatives into the scratch (N, dN, derivatives) (:func:`projection_scratch`)."""
     N, dN, derivatives = scratch
     face_functions(r, s, N, dN)
-    derivatives[:] = 0.0
-    point[:] = 0.0
-    for a in range(9):
-        for i in range(3):
+    for i in range(3):
+        # the sums held in registers, node by node in order as before (summed in the arrays,
+        # a face's evaluation took 155 ns against 103: the same bits, one and a half times as long)
+        p, pr, ps, prr, pss, prs = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        for a in range(9):
             value = x[nodes[a], i]
-            point[i] += N[a] * value
-            for k in range(5):
-                derivatives[k, i] += dN[k, a] * value
+            p += N[a] * value
+            pr += dN[0, a] * value
+            ps += dN[1, a] * value
+            prr += dN[2, a] * value
+            pss += dN[3, a] * value
+            prs += dN[4, a] * value
+        point[i] = p
+        derivatives[0, i], derivatives[1, i], derivatives[2, i] = pr, ps, prr
+        derivatives[3, i], derivatives[4, i] = pss, prs
 
 
 @njit(cache=True)
@@ -107,6 +114,11 @@ def nearest_point(x, nodes, y, rs, point, normal, scratch):
         else:
             dr = -(hss * gr - hrs * gs) / det
             ds = -(hrr * gs - hrs * gr) / det
+        if abs(min(1.0, max(-1.0, r + dr)) - r) + abs(min(1.0, max(-1.0, s + ds)) - s) < _CONVERGED:
+            # converged: the point, its derivatives and shape functions are those at (r, s)
+            # (evaluating the step's end first made 3.1 evaluations of a face a projection
+            # on two stacked plates, against 1.9, for a distance that moved by 3e-16 of itself)
+            break
         step = 1.0
         for _ in range(_HALVINGS):  # halved until the distance does not grow
             r_new = min(1.0, max(-1.0, r + step * dr))
@@ -149,16 +161,12 @@ _LINES = ((1, 4, 0), (5, 8, 7), (2, 6, 3), (2, 5, 1), (6, 8, 4), (3, 7, 0))
 
 
 @njit(cache=True)
-def build_grid(x, faces, reach, grid):
-    """The bucket grid of the faces (F, 9) (their nodes' numbers in x (n, 3)): grid =
-    (boxes (F, 6) lower and upper corners of each face, start (B + 1,) each bucket's
-    first entry, entries (8 F,) face rows by bucket), filled in place. A box holds its
-    face: its nodes' box grown by as far as a biquadratic face bulges past them (along
-    each line of nodes, a quadratic overshoots them by at most an eighth of its second
-    difference; across the lines, by 1.25 times that of the lines' values); each face is
-    listed in the cells its box grown by reach (F,) covers (:func:`fill_grid`). Returns
-    the cell width and the grid's origin corner (3,)."""
-    boxes = grid[0]
+def face_boxes(x, faces, boxes):
+    """boxes (F, 6): the lower and upper corners of each face (F, 9) (its nodes' numbers
+    in x (n, 3)), filled in place. A box holds its face: its nodes' box grown by as far as
+    a biquadratic face bulges past them (along each line of nodes, a quadratic overshoots
+    them by at most an eighth of its second difference; across the lines, by 1.25 times
+    that of the lines' values)."""
     for f in range(faces.shape[0]):
         for i in range(3):
             low, high = np.inf, -np.inf
@@ -177,7 +185,6 @@ def build_grid(x, faces, reach, grid):
             bulge = 0.125 * along + 0.15625 * across
             boxes[f, i] = low - bulge
             boxes[f, 3 + i] = high + bulge
-    return fill_grid(reach, grid)
 
 
 @njit(cache=True)

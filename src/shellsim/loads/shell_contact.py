@@ -29,6 +29,15 @@ at most s / dt_c^2 per pass; with both passes in parallel the critical step is t
 dt_c / sqrt(1 + s / 2). The springs' scale is fixed when the run starts
 (:func:`calibrate`), so the forces are conservative but for the nearest point's slide
 along the face.
+
+The search keeps each contact node's list of the faces it may touch (Verlet's neighbour
+lists, Phys. Rev. 159, 98, 1967): those whose box lies within the contact's reach
+and a skin more (:data:`SKIN`), found on the bucket grid. While the nodes and the faces'
+boxes have moved less than the skin since the lists were made, no face outside a node's
+list can come within its reach, so an evaluation tests only the listed faces, against
+the reach as it is, and finds the same faces the grid would; beyond that the lists are
+made again. On two stacked plates whose every node touches, a grid cell held some 74
+faces for a node and 2.2 of them within reach.
 """
 
 from __future__ import annotations
@@ -47,7 +56,7 @@ from ..errors import MeshError
 from ..table_types import Name, NonNegative, Positive
 from . import penalty_law
 from .penalty_law import TOUCHING
-from .contact_search import build_grid, cell_faces, near_box, nearest_point, projection_scratch
+from .contact_search import cell_faces, face_boxes, fill_grid, near_box, nearest_point, projection_scratch
 from .table import ContactTable
 
 
@@ -98,6 +107,12 @@ PASSES = MOST_SURFACES**2
 #: The most faces a node may overlap in the initial shape (those it never meets).
 IGNORED = 32
 
+#: The most faces a contact node's list holds; a node near more is searched on the grid.
+NEAR = 32
+#: How much farther than the contact's reach the lists look, a share of the largest
+#: reach: the nodes and faces may move this far (together) before they are made again.
+SKIN = 0.5
+
 #: How much farther than the contact's reach the gaps are looked for (an output's, not
 #: the search's: the clearance up to about a thickness shows where faces come close).
 GAP_REACH = 2.0
@@ -122,7 +137,11 @@ class Bundle(NamedTuple):
     face_inverse_mass (F, 9) (0 until :func:`calibrate`). Scratch: touches (K,) each
     contact node's face row (-1: none) and touch_forces (K, 10, 3) the forces on it and
     the face's nodes; of the search, reach (F,), boxes (F, 6), start (2 F + 1 per table,),
-    entries (8 F,)."""
+    entries (8 F,). The faces' lists (the module's text): near (K, :data:`NEAR`) each
+    contact node's face rows and near_count (K,) how many (-1: more than fit, searched on
+    the grid), listed_at (K, 3) where the node was when they were made, listed_boxes
+    (F, 6) and listed_reach (F,) each face's box and the reach they were made with (the
+    contact's and the skin), and listed (1,) whether they are made (1) or are to be (0)."""
 
     nodes: np.ndarray
     tool: np.ndarray
@@ -146,6 +165,12 @@ class Bundle(NamedTuple):
     boxes: np.ndarray
     start: np.ndarray
     entries: np.ndarray
+    near: np.ndarray
+    near_count: np.ndarray
+    listed_at: np.ndarray
+    listed_boxes: np.ndarray
+    listed_reach: np.ndarray
+    listed: np.ndarray
 
 
 def build(table: ShellContact, scene) -> Bundle:
@@ -235,7 +260,10 @@ def _passes(passes: list, conn: np.ndarray, place: int, table: ShellContact) -> 
         face_group=joined([np.full(len(e), PASSES * place + i) for i, (_, e) in enumerate(passes)]),
         face_inverse_mass=np.zeros((f, 9)), touches=np.full(k, -1, dtype=np.int64),
         touch_forces=np.zeros((k, 10, 3)), reach=np.zeros(f), boxes=np.zeros((f, 6)),
-        start=np.zeros(2 * f + 1 if f else 0, dtype=np.int64), entries=np.zeros(8 * f, dtype=np.int64))
+        start=np.zeros(2 * f + 1 if f else 0, dtype=np.int64), entries=np.zeros(8 * f, dtype=np.int64),
+        near=np.zeros((k, NEAR), dtype=np.int32), near_count=np.zeros(k, dtype=np.int64),
+        listed_at=np.zeros((k, 3)), listed_boxes=np.zeros((f, 6)), listed_reach=np.zeros(f),
+        listed=np.zeros(1, dtype=np.int64))
 
 
 def calibrate(loads: Bundle, masses: np.ndarray, rotary: np.ndarray, h: np.ndarray, dt: float) -> None:
@@ -266,18 +294,32 @@ def _at_initial_thickness(model, shape):
 @njit(cache=True)
 def _work():
     """The scratch of a contact's geometry: (rs (2,), point (3,), normal (3,)) of the
-    nearest point and :func:`shellsim.loads.contact_search.projection_scratch`."""
-    return (np.empty(2), np.empty(3), np.empty(3)), projection_scratch()
+    nearest point, :func:`shellsim.loads.contact_search.projection_scratch`, and the
+    deepest face's (N (9,), normal (3,), (depth, smoothing) (2,)) as :func:`_touched`
+    keeps them (:func:`_keep`)."""
+    return (np.empty(2), np.empty(3), np.empty(3)), projection_scratch(), (np.empty(9), np.empty(3), np.empty(2))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _keep(work, depth, smoothing):
+    """Keep the last face's shape functions and normal at its nearest point, its depth
+    and smoothing in work[2] (:func:`_work`): the pair's forces are those of the deepest
+    face, which the search projected onto already (projecting again took a third of the
+    projections)."""
+    N, normal, pair = work[2]
+    copy_into(work[1][0], N)
+    copy_into(work[0][2], normal)
+    pair[0], pair[1] = depth, smoothing
+
+
+@njit(cache=True, inline="always")
 def _depth(x, h, loads, m, row, work):
     """How deep contact node m is into face row ``row``, the shape (x (n, 3), h (n,))
     given: offset (h_y + h_p) / 2 less their distance (-gap), and the width of the
     penalty's smoothing there (:data:`TOUCHING` of that offset). work = (contact,
     scratch) of :func:`_work`: the nearest point's (rs (2,), point (3,), normal (3,)) and
     its shape functions left in scratch[0]."""
-    (rs, point, normal), scratch = work
+    (rs, point, normal), scratch = work[0], work[1]
     nodes = loads.faces[row]
     node = loads.nodes[m]
     distance = nearest_point(x, nodes, x[node], rs, point, normal, scratch)
@@ -300,10 +342,18 @@ def _holds(nodes, node):
 
 @njit(cache=True)
 def _grid(shape, loads, widening):
-    """The search grid of the faces on the current shape: each face's box grown by the
-    largest reach of the nodes tested against it (those of its pass: half their largest
-    fibre length times offset, and the face's own largest times their largest offset,
-    and the smoothing), times ``widening``. Returns (width, origin) (:func:`build_grid`).
+    """The search grid of the faces on the current shape (:func:`_bounds`, the reach times
+    ``widening``). Returns (width, origin) (:func:`fill_grid`)."""
+    _bounds(shape, loads, widening)
+    return fill_grid(loads.reach, (loads.boxes, loads.start, loads.entries))
+
+
+@njit(cache=True)
+def _bounds(shape, loads, widening):
+    """Each face's box on the current shape into loads.boxes, and its reach into
+    loads.reach: the largest of the nodes tested against it (those of its pass: half their
+    largest fibre length times offset, and the face's own largest times their largest
+    offset, and the smoothing), times ``widening``.
     Per pass, not over the table: a surface against itself reaches a few tenths of its
     node spacing (``own_surface_limit``), against another surface the whole thickness,
     and with the whole thickness every face of its own surface near a node had its
@@ -325,7 +375,7 @@ def _grid(shape, loads, widening):
             thickest = max(thickest, h[loads.faces[f, a]])
         g = loads.face_group[f]
         loads.reach[f] = 0.5 * (deepest[g] + widest[g] * thickest) * (1.0 + TOUCHING) * widening
-    return build_grid(shape.x, loads.faces, loads.reach, (loads.boxes, loads.start, loads.entries))
+    face_boxes(shape.x, loads.faces, loads.boxes)
 
 
 @njit(cache=True)
@@ -359,6 +409,7 @@ def _candidates(shape, loads, m, grid, work, ignoring):
                 listed += 1
         elif depth > deepest:
             best, deepest = row, depth
+            _keep(work, depth, smoothing)
     return best
 
 
@@ -420,8 +471,113 @@ def _ignored(loads, m, row):
 @njit(cache=True)
 def _touched(shape, loads, m, grid, work):
     """The face row contact node m is deepest into on the current shape (-1: none), of
-    the faces that neither hold it nor overlapped it in the initial shape."""
-    return _candidates(shape, loads, m, grid, work, True)
+    the faces that neither hold it nor overlapped it in the initial shape: of its list
+    (:func:`_search`), or of ``grid``'s cell where the list could not hold them; that
+    face's nearest point kept in work[2] (:func:`_keep`)."""
+    count = loads.near_count[m]
+    if count < 0:
+        return _candidates(shape, loads, m, grid, work, True)
+    y = shape.x[loads.nodes[m]]
+    best, deepest = -1, -np.inf
+    for k in range(count):
+        row = loads.near[m, k]
+        if not near_box(y, loads.boxes, row, loads.reach[row]):
+            continue
+        depth, smoothing = _depth(shape.x, shape.h, loads, m, row, work)
+        if depth > -smoothing and depth > deepest:
+            best, deepest = row, depth
+            _keep(work, depth, smoothing)
+    return best
+
+
+@njit(cache=True)
+def _search(shape, loads):
+    """The boxes and reach of the faces on the current shape (:func:`_bounds`), each
+    contact node's list of faces made again where the nodes and boxes have moved more
+    than the lists' skin (the module's text). Returns the grid (width, origin) that the
+    nodes whose lists overflowed read (:func:`_touched`): made with the lists, or on the
+    current shape where they hold; none (0, inf) where every list holds its faces."""
+    _bounds(shape, loads, 1.0)
+    if loads.listed[0] and _lists_hold(shape, loads):
+        for m in range(loads.nodes.shape[0]):
+            if loads.near_count[m] < 0:
+                return fill_grid(loads.reach, (loads.boxes, loads.start, loads.entries))
+        return 0.0, np.full(3, np.inf)
+    skin = 0.0
+    for f in range(loads.faces.shape[0]):
+        skin = max(skin, SKIN * loads.reach[f])
+    for f in range(loads.faces.shape[0]):
+        loads.listed_reach[f] = loads.reach[f] + skin
+    copy_into(loads.boxes, loads.listed_boxes)
+    grid = fill_grid(loads.listed_reach, (loads.boxes, loads.start, loads.entries))
+    _list_faces(shape, loads, grid)
+    loads.listed[0] = 1
+    return grid
+
+
+@njit(cache=True)
+def _lists_hold(shape, loads):
+    """Whether every face that may be within a contact node's reach on the current shape
+    is in its list: the node's move since they were made plus the largest move of a face
+    box's bounds (each axis' larger of its two) is less than the skin, the least of the
+    lists' reach over the current one."""
+    skin = np.inf
+    for f in range(loads.faces.shape[0]):
+        skin = min(skin, loads.listed_reach[f] - loads.reach[f])
+    boxes_moved = 0.0
+    for f in range(loads.faces.shape[0]):
+        squared = 0.0
+        for i in range(3):
+            bound = max(abs(loads.boxes[f, i] - loads.listed_boxes[f, i]),
+                        abs(loads.boxes[f, 3 + i] - loads.listed_boxes[f, 3 + i]))
+            squared += bound * bound
+        boxes_moved = max(boxes_moved, squared)
+    nodes_moved = 0.0
+    for m in range(loads.nodes.shape[0]):
+        y = shape.x[loads.nodes[m]]
+        nodes_moved = max(nodes_moved, (y[0] - loads.listed_at[m, 0]) ** 2 + (y[1] - loads.listed_at[m, 1]) ** 2
+                          + (y[2] - loads.listed_at[m, 2]) ** 2)
+    # the distance of a node from a box moves by at most the two moves together
+    return np.sqrt(nodes_moved) + np.sqrt(boxes_moved) < skin
+
+
+@njit(cache=True, parallel=True)
+def _list_faces(shape, loads, grid):
+    """Each contact node's list of the faces it may touch (:func:`_list_node`), the
+    nodes shared among the threads. (The node's loop, with its break, written out in the
+    parallel loop left every list empty: numba 0.68's parallel lowering.)"""
+    count = loads.nodes.shape[0]
+    chunks = min(count, CHUNKS)
+    for c in prange(chunks):
+        for m in range(c * count // chunks, (c + 1) * count // chunks):
+            _list_node(shape, loads, m, grid)
+
+
+@njit(cache=True)
+def _list_node(shape, loads, m, grid):
+    """Contact node m's list of the faces it may touch (those of its group that do not
+    hold it and that it did not overlap at rest) within their listed reach of it, of
+    ``grid``'s cell (made with that reach), into loads.near[m] and loads.near_count[m]
+    (-1 where more than :data:`NEAR`), and where it is into loads.listed_at[m]."""
+    width, origin = grid
+    node = loads.nodes[m]
+    y = shape.x[node]
+    first, stop = cell_faces(y, width, origin, loads.start)
+    listed = 0
+    for entry in range(first, stop):
+        row = loads.entries[entry]
+        if loads.face_group[row] != loads.group[m] or not near_box(y, loads.boxes, row, loads.listed_reach[row]) \
+                or _holds(loads.faces[row], node) or _ignored(loads, m, row):
+            continue
+        if listed == NEAR:
+            listed = -1
+            break
+        loads.near[m, listed] = row
+        listed += 1
+    loads.near_count[m] = listed
+    copy_into(y, loads.listed_at[m])
+
+
 
 
 @njit(cache=True)
@@ -444,13 +600,21 @@ def _pair_spring(x, h, loads, m, row, work):
     (x, h) given: :func:`_depth`'s and the pair's spring k (the module's text; 0 where they
     are apart or the springs are not set yet)."""
     depth, smoothing = _depth(x, h, loads, m, row, work)
-    if depth <= -smoothing or loads.spring[m] == 0.0:
+    if depth <= -smoothing:
         return depth, smoothing, 0.0
-    N = work[1][0]
+    return depth, smoothing, _spring(loads, m, row, work[1][0])
+
+
+@njit(cache=True, inline="always")
+def _spring(loads, m, row, N):
+    """The spring k of contact node m against face row ``row`` whose shape functions at
+    the nearest point are N (9,) (the module's text; 0 while the springs are not set)."""
+    if loads.spring[m] == 0.0:
+        return 0.0
     weight = loads.inverse_mass[m]
     for a in range(9):
         weight += N[a] * N[a] * loads.face_inverse_mass[row, a]
-    return depth, smoothing, loads.spring[m] / weight
+    return loads.spring[m] / weight
 
 
 @njit(cache=True)
@@ -461,12 +625,17 @@ def _pair_forces(x, h, loads, m, row, out, work):
     the smoothing width w of touching the push is :mod:`shellsim.loads.penalty_law`'s
     (a body resting on another has a stiffness before it penetrates)."""
     depth, smoothing, spring = _pair_spring(x, h, loads, m, row, work)
+    _push(spring, depth, smoothing, work[1][0], work[0][2], out)
+
+
+@njit(cache=True, inline="always")
+def _push(spring, depth, smoothing, N, normal, out):
+    """out (10, 3): :func:`_pair_forces` of a pair whose spring, depth and smoothing are
+    given, N (9,) and normal (3,) at its face's nearest point."""
     out[:] = 0.0
     if spring == 0.0:
         return
-    N = work[1][0]
     push = penalty_law.push(spring, depth, smoothing)
-    normal = work[0][2]
     for i in range(3):
         out[0, i] = push * normal[i]
         for a in range(9):
@@ -478,7 +647,7 @@ def _contact_forces(model, shape, loads):
     """Each contact node's face on the current shape into loads.touches (K,) (-1: none)
     and the ten nodes' forces of its contact into loads.touch_forces (K, 10, 3), the
     nodes shared among the threads (each node's contact is its own)."""
-    grid = _grid(shape, loads, 1.0)
+    grid = _search(shape, loads) if not loads.holding[0] else (0.0, np.full(3, np.inf))
     count = loads.nodes.shape[0]
     chunks = min(count, CHUNKS)
     for c in prange(chunks):
@@ -490,12 +659,18 @@ def _contact_chunk(first, stop, shape, loads, grid):
     """:func:`_contact_forces` of contact nodes first..stop-1 (the held pairs' faces while
     they are held)."""
     work = _work()
+    N, normal, pair = work[2]
     for m in range(first, stop):
-        row = loads.held[m] if loads.holding[0] else _touched(shape, loads, m, grid, work)
-        loads.touches[m] = row
-        if row >= 0:
-            _pair_forces(shape.x, shape.h, loads, m, row, loads.touch_forces[m], work)
+        if loads.holding[0]:
+            row = loads.held[m]
+            if row >= 0:
+                _pair_forces(shape.x, shape.h, loads, m, row, loads.touch_forces[m], work)
         else:
+            row = _touched(shape, loads, m, grid, work)
+            if row >= 0:
+                _push(_spring(loads, m, row, N), pair[0], pair[1], N, normal, loads.touch_forces[m])
+        loads.touches[m] = row
+        if row < 0:
             loads.touch_forces[m] = 0.0
 
 
@@ -704,7 +879,7 @@ def _differenced_pairs(model, shape, loads, motion, step_u, nodes, blocks, frict
     """:func:`couplings` of the pairs' forces, or (``friction``) of their friction at the
     velocities of ``motion`` (v (n, 3), rate) of the pairs with friction."""
     shape = _at_initial_thickness(model, shape)
-    grid = _grid(shape, loads, 1.0)
+    grid = _search(shape, loads) if not loads.holding[0] else (0.0, np.full(3, np.inf))
     work = _work()
     pushed, plus, minus = np.empty((10, 3)), np.empty((10, 3)), np.empty((10, 3))
     scratch = (np.empty(3), np.empty(9))

@@ -448,11 +448,11 @@ def overlaps_at_rest(loads: Bundle, tables: list, x: np.ndarray) -> list[str]:
 
 
 @njit(cache=True, inline="always")
-def _may_touch(loads, m, row, y, ignoring):
+def _may_touch(loads, m, row, y, reach, ignoring):
     """Whether contact node m, at y (3,), is tested against face row ``row``: a face of its
-    group within the search's reach that does not hold it (nor, where ``ignoring``, one
-    it overlapped in the initial shape)."""
-    return loads.face_group[row] == loads.group[m] and near_box(y, loads.boxes, row, loads.reach[row]) \
+    group within ``reach`` (F,) of it (the search's, or the lists') that does not hold it
+    (nor, where ``ignoring``, one it overlapped in the initial shape)."""
+    return loads.face_group[row] == loads.group[m] and near_box(y, loads.boxes, row, reach[row]) \
         and not _holds(loads.faces[row], loads.nodes[m]) and not (ignoring and _ignored(loads, m, row))
 
 
@@ -496,7 +496,10 @@ def _search(shape, loads):
     contact node's list of faces made again where the nodes and boxes have moved more
     than the lists' skin (the module's text). Returns the grid (width, origin) that the
     nodes whose lists overflowed read (:func:`_touched`): made with the lists, or on the
-    current shape where they hold; none (0, inf) where every list holds its faces."""
+    current shape where they hold; none (0, inf) where every list holds its faces, or
+    while the pairs are held (:func:`hold_pairs`: nothing is searched)."""
+    if loads.holding[0]:
+        return 0.0, np.full(3, np.inf)
     _bounds(shape, loads, 1.0)
     if loads.listed[0] and _lists_hold(shape, loads):
         for m in range(loads.nodes.shape[0]):
@@ -566,8 +569,7 @@ def _list_node(shape, loads, m, grid):
     listed = 0
     for entry in range(first, stop):
         row = loads.entries[entry]
-        if loads.face_group[row] != loads.group[m] or not near_box(y, loads.boxes, row, loads.listed_reach[row]) \
-                or _holds(loads.faces[row], node) or _ignored(loads, m, row):
+        if not _may_touch(loads, m, row, y, loads.listed_reach, True):
             continue
         if listed == NEAR:
             listed = -1
@@ -576,8 +578,6 @@ def _list_node(shape, loads, m, grid):
         listed += 1
     loads.near_count[m] = listed
     copy_into(y, loads.listed_at[m])
-
-
 
 
 @njit(cache=True)
@@ -647,7 +647,7 @@ def _contact_forces(model, shape, loads):
     """Each contact node's face on the current shape into loads.touches (K,) (-1: none)
     and the ten nodes' forces of its contact into loads.touch_forces (K, 10, 3), the
     nodes shared among the threads (each node's contact is its own)."""
-    grid = _search(shape, loads) if not loads.holding[0] else (0.0, np.full(3, np.inf))
+    grid = _search(shape, loads)
     count = loads.nodes.shape[0]
     chunks = min(count, CHUNKS)
     for c in prange(chunks):
@@ -800,7 +800,7 @@ def _nearest_face(shape, loads, m, grid, work):
     nearest, gap = -1, np.inf
     for entry in range(first, stop):
         row = loads.entries[entry]
-        if _may_touch(loads, m, row, y, True):
+        if _may_touch(loads, m, row, y, loads.reach, True):
             depth = _depth(shape.x, shape.h, loads, m, row, work)[0]
             if -depth < gap:
                 nearest, gap = row, -depth
@@ -879,7 +879,7 @@ def _differenced_pairs(model, shape, loads, motion, step_u, nodes, blocks, frict
     """:func:`couplings` of the pairs' forces, or (``friction``) of their friction at the
     velocities of ``motion`` (v (n, 3), rate) of the pairs with friction."""
     shape = _at_initial_thickness(model, shape)
-    grid = _search(shape, loads) if not loads.holding[0] else (0.0, np.full(3, np.inf))
+    grid = _search(shape, loads)
     work = _work()
     pushed, plus, minus = np.empty((10, 3)), np.empty((10, 3)), np.empty((10, 3))
     scratch = (np.empty(3), np.empty(9))
